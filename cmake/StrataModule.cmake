@@ -1,0 +1,26 @@
+# strata_add_module(NAME <name> SOURCES <files...> PUBLIC_LINKS <...> PRIVATE_LINKS <...>)
+# One stage = one folder = one namespace = one library target strata_<name>, alias Strata::<name>.
+function(strata_add_module)
+  cmake_parse_arguments(ARG "" "NAME" "SOURCES;PUBLIC_LINKS;PRIVATE_LINKS" ${ARGN})
+  set(target strata_${ARG_NAME})
+  add_library(${target} ${ARG_SOURCES})
+  add_library(Strata::${ARG_NAME} ALIAS ${target})
+  target_compile_features(${target} PUBLIC cxx_std_17)
+  target_include_directories(${target}
+    PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>
+    PRIVATE ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  strata_set_warnings(${target})
+endfunction()
+
+# strata_add_gtest(<name> <sources...> LINKS <targets...>): one test binary, discovered by CTest.
+function(strata_add_gtest name)
+  cmake_parse_arguments(ARG "" "" "LINKS" ${ARGN})
+  add_executable(${name} ${ARG_UNPARSED_ARGUMENTS})
+  target_link_libraries(${name} PRIVATE ${ARG_LINKS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE
+    STRATA_DATA_DIR="${STRATA_DATA_DIR}" STRATA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  strata_set_warnings(${name})
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+endfunction()

@@ -1,0 +1,15 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+// Each subcommand lives in its own file and registers itself on the top-level app.
+// Registration adds options and a callback; the callback does the work and throws on failure.
+namespace strata::tools {
+
+void RegisterIntegrate(CLI::App& app);
+void RegisterInfo(CLI::App& app);
+void RegisterExport(CLI::App& app);
+void RegisterDemo(CLI::App& app);
+void RegisterSimulate(CLI::App& app);
+
+}  // namespace strata::tools
