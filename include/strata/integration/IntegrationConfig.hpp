@@ -1,0 +1,27 @@
+#pragma once
+
+#include <cstddef>
+
+namespace strata::integration {
+
+/// @brief How scans become occupancy. Defaults are OctoMap's, so maps compare voxel by voxel.
+struct IntegrationConfig {
+    double max_range_m = 50.0;  ///< longer rays clear free space up to this range, record no hit
+    double min_range_m = 0.0;   ///< closer points are dropped entirely (e.g. hits on the vehicle)
+    double prob_hit = 0.7;      ///< OctoMap default, log-odds +0.85
+    double prob_miss = 0.4;     ///< OctoMap default, log-odds -0.41
+    double clamp_min_prob = 0.1192;  ///< OctoMap default, log-odds -2.0
+    double clamp_max_prob = 0.971;   ///< OctoMap default, log-odds +3.5
+    float label_vote_weight = 1.0f;  ///< vote of one labelled point in the semantic fusion
+    /// Mark endpoints only, no free space: for clouds without a sensor origin (a pre-built map,
+    /// an airborne LAS tile).
+    bool points_only = false;
+    /// Per-thread budget of the dense scratch bitmap covering one scan's bounding box; scans whose
+    /// box needs more are marked sparsely (slower, bounded memory).
+    size_t dense_scratch_limit_bytes = size_t{64} << 20;
+
+    /// @brief Throws std::invalid_argument naming the first bad field.
+    void Validate() const;
+};
+
+}  // namespace strata::integration

@@ -1,0 +1,59 @@
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <cstddef>
+#include <vector>
+
+#include "strata/core/Scan.hpp"
+#include "strata/core/VoxelMap.hpp"
+#include "strata/integration/IntegrationConfig.hpp"
+
+namespace strata::integration {
+
+/// @brief Points of one scan that ended in one voxel with one class.
+struct EndpointGroup {
+    openvdb::Coord ijk;
+    int32_t points = 0;
+    core::SemanticClass label = core::SemanticClass::kUnknown;
+};
+
+/// @brief What one scan observed, before it touches a map (ARCHITECTURE.md, "Integration
+/// semantics"): every voxel at most once, occupied winning over free.
+struct ScanUpdate {
+    openvdb::MaskTree::Ptr free;      ///< voxels the rays crossed, endpoints excluded; never null
+    openvdb::MaskTree::Ptr occupied;  ///< endpoint voxels; never null
+    std::vector<EndpointGroup> endpoints;  ///< sorted by voxel then class
+    size_t points = 0;   ///< points in the scan
+    size_t dropped = 0;  ///< NaN/inf, or closer than min_range_m
+    size_t clipped = 0;  ///< beyond max_range_m: cleared free space, recorded no hit
+};
+
+/// @brief Computes the update of one scan against a map's voxel grid (the map is not modified).
+/// Parallel over rays (TBB); the result does not depend on the number of threads.
+/// @throw std::invalid_argument on an invalid config or scan.
+[[nodiscard]] ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
+                                           const IntegrationConfig& config);
+
+/// @brief Applies an update: log-odds miss on free voxels, hit on occupied ones (clamped),
+/// endpoint counts into `hits`, label votes into `label` / `label_weight`.
+void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
+                     const IntegrationConfig& config);
+
+/// @brief Integrates scans one by one into a map it does not own.
+class Integrator {
+public:
+    /// @throw std::invalid_argument on an invalid config.
+    Integrator(core::VoxelMap& map, const IntegrationConfig& config);
+
+    /// @brief ComputeScanUpdate then ApplyScanUpdate; returns the update it applied.
+    ScanUpdate Integrate(const core::Scan& scan);
+
+    [[nodiscard]] const IntegrationConfig& config() const { return config_; }
+
+private:
+    core::VoxelMap& map_;
+    IntegrationConfig config_;
+};
+
+}  // namespace strata::integration

@@ -1,0 +1,31 @@
+#include "strata/integration/IntegrationConfig.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace strata::integration {
+namespace {
+
+void Require(bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("integration config: " + what);
+}
+
+bool IsProbability(double p) { return p > 0.0 && p < 1.0; }
+
+}  // namespace
+
+void IntegrationConfig::Validate() const {
+    Require(std::isfinite(max_range_m) && max_range_m > 0.0, "max_range_m must be positive");
+    Require(std::isfinite(min_range_m) && min_range_m >= 0.0 && min_range_m < max_range_m,
+            "min_range_m must be in [0, max_range_m)");
+    Require(IsProbability(prob_hit) && prob_hit > 0.5, "prob_hit must be in (0.5, 1)");
+    Require(IsProbability(prob_miss) && prob_miss < 0.5, "prob_miss must be in (0, 0.5)");
+    Require(IsProbability(clamp_min_prob) && IsProbability(clamp_max_prob) &&
+                clamp_min_prob < 0.5 && clamp_max_prob > 0.5,
+            "clamp probabilities must satisfy 0 < min < 0.5 < max < 1");
+    Require(std::isfinite(label_vote_weight) && label_vote_weight > 0.0f,
+            "label_vote_weight must be positive");
+}
+
+}  // namespace strata::integration

@@ -1,0 +1,89 @@
+#include "strata/integration/Integrator.hpp"
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+
+#include "ApplyUpdate.hpp"
+#include "RayMarking.hpp"
+
+namespace strata::integration {
+namespace {
+
+// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted.
+std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
+                                          const core::Scan& scan) {
+    std::vector<uint64_t> keys(prepared.endpoint_pos.size());
+    for (size_t i = 0; i < keys.size(); ++i) {
+        const auto label = scan.has_labels() ? scan.labels[prepared.endpoint_point[i]]
+                                             : core::SemanticClass::kUnknown;
+        keys[i] = (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
+                  static_cast<uint64_t>(label);
+    }
+    tbb::parallel_sort(keys.begin(), keys.end());
+    std::vector<EndpointGroup> groups;
+    const detail::VoxelBox& box = prepared.box;
+    for (size_t i = 0; i < keys.size();) {
+        size_t j = i;
+        while (j < keys.size() && keys[j] == keys[i]) ++j;
+        const auto pos = static_cast<int64_t>(keys[i] >> 8);
+        const int64_t xy = pos / box.nz;
+        EndpointGroup g;
+        g.ijk = box.lo + openvdb::Coord(static_cast<int32_t>(xy / box.ny),
+                                        static_cast<int32_t>(xy % box.ny),
+                                        static_cast<int32_t>(pos % box.nz));
+        g.points = static_cast<int32_t>(j - i);
+        g.label = static_cast<core::SemanticClass>(keys[i] & 0xff);
+        groups.push_back(g);
+        i = j;
+    }
+    return groups;
+}
+
+}  // namespace
+
+ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
+                             const IntegrationConfig& config) {
+    config.Validate();
+    scan.Validate();
+    if (!(map.voxel_size > 0.0)) throw std::invalid_argument("the map has no voxel size");
+
+    // Map frame = world frame shifted by the map's georeferenced origin.
+    std::vector<Eigen::Vector3d> points_map(scan.points.size());
+    const Eigen::Isometry3d T_map_sensor =
+        Eigen::Translation3d(-map.origin) * scan.T_world_sensor;
+    for (size_t i = 0; i < scan.points.size(); ++i) points_map[i] = T_map_sensor * scan.points[i];
+
+    const detail::PreparedScan prepared =
+        detail::PrepareScan(points_map, T_map_sensor.translation(), map.voxel_size, config);
+    detail::ScanMasks masks = detail::MarkScan(prepared, config);
+
+    ScanUpdate update;
+    update.free = masks.free;
+    update.occupied = masks.occupied;
+    update.endpoints = GroupEndpoints(prepared, scan);
+    update.points = scan.points.size();
+    update.dropped = prepared.dropped;
+    update.clipped = prepared.clipped;
+    return update;
+}
+
+void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
+                     const IntegrationConfig& config) {
+    config.Validate();
+    detail::ApplyOccupancy(update, *map.occupancy, config);
+    detail::ApplyEndpoints(update, map, config);
+}
+
+Integrator::Integrator(core::VoxelMap& map, const IntegrationConfig& config)
+    : map_(map), config_(config) {
+    config_.Validate();
+}
+
+ScanUpdate Integrator::Integrate(const core::Scan& scan) {
+    ScanUpdate update = ComputeScanUpdate(scan, map_, config_);
+    ApplyScanUpdate(update, map_, config_);
+    return update;
+}
+
+}  // namespace strata::integration

@@ -1,0 +1,176 @@
+// Step 2 of integrating a scan: mark the voxels every ray crosses (exact 3D DDA, Amanatides-Woo),
+// in parallel over rays into thread-local bitmaps, then turn the bitmaps into VDB masks.
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "RayMarking.hpp"
+
+namespace strata::integration::detail {
+namespace {
+
+using MaskLeaf = openvdb::MaskTree::LeafNodeType;
+constexpr size_t kRayGrain = 2048;
+
+// A zero-filled bitmap from calloc: fresh pages arrive zeroed from the OS, so a large bitmap
+// costs only the pages a scan touches.
+struct Bitmap {
+    struct Free {
+        void operator()(uint8_t* p) const { std::free(p); }
+    };
+    std::unique_ptr<uint8_t, Free> bytes;
+    explicit Bitmap(size_t n) : bytes(static_cast<uint8_t*>(std::calloc(n, 1))) {
+        if (!bytes) throw std::bad_alloc();
+    }
+    void Set(int64_t pos) { bytes.get()[pos >> 3] |= static_cast<uint8_t>(1u << (pos & 7)); }
+};
+
+// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel and every voxel up to, not
+// including, the end voxel. Terminating on the crossing count replaces OctoMap's key comparison.
+// `in_box` bounds every write, whatever the rounding does.
+template <typename MarkFn>
+inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark) {
+    int64_t pos = ray.start;
+    mark(pos);
+    double t0 = ray.t_max[0], t1 = ray.t_max[1], t2 = ray.t_max[2];
+    for (int32_t s = 1; s < ray.steps; ++s) {
+        // Same tie-breaking as OctoMap: x before z, y before z, y before x only when strictly less.
+        if (t0 < t1) {
+            if (t0 < t2) {
+                t0 += ray.t_delta[0];
+                pos += ray.stride[0];
+            } else {
+                t2 += ray.t_delta[2];
+                pos += ray.stride[2];
+            }
+        } else if (t1 < t2) {
+            t1 += ray.t_delta[1];
+            pos += ray.stride[1];
+        } else {
+            t2 += ray.t_delta[2];
+            pos += ray.stride[2];
+        }
+        if (static_cast<uint64_t>(pos) >= box_size) return;
+        mark(pos);
+    }
+}
+
+openvdb::Coord PosToCoord(const VoxelBox& box, int64_t pos) {
+    const int64_t z = pos % box.nz;
+    const int64_t xy = pos / box.nz;
+    return box.lo + openvdb::Coord(static_cast<int32_t>(xy / box.ny),
+                                   static_cast<int32_t>(xy % box.ny), static_cast<int32_t>(z));
+}
+
+// One 8x8x8 brick of a bitmap as the eight 64-bit words of a VDB leaf mask (offset x<<6|y<<3|z:
+// word = x, byte = y, bit = z), which is the bitmap's byte layout since z is fastest.
+void GatherBrick(const VoxelBox& box, const uint8_t* bytes, int64_t bx, int64_t by, int64_t bz,
+                 uint64_t words[8]) {
+    for (int64_t x = 0; x < 8; ++x) {
+        uint64_t w = 0;
+        for (int64_t y = 0; y < 8; ++y) {
+            const int64_t byte = (((bx + x) * box.ny + (by + y)) * box.nz + bz) >> 3;
+            w |= uint64_t{bytes[byte]} << (8 * y);
+        }
+        words[x] = w;
+    }
+}
+
+ScanMasks MarkDense(const PreparedScan& scan) {
+    const VoxelBox& box = scan.box;
+    const auto n_bytes = static_cast<size_t>(box.size() / 8);
+    tbb::enumerable_thread_specific<Bitmap> free_bits([n_bytes] { return Bitmap(n_bytes); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, scan.rays.size(), kRayGrain),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          Bitmap& bits = free_bits.local();
+                          for (size_t i = range.begin(); i != range.end(); ++i) {
+                              TraceRay(scan.rays[i], static_cast<uint64_t>(box.size()),
+                                       [&bits](int64_t pos) { bits.Set(pos); });
+                          }
+                      });
+    Bitmap occupied_bits(n_bytes);
+    for (const int64_t pos : scan.endpoint_pos) occupied_bits.Set(pos);
+
+    // Bricks to leaves, parallel over x-slabs of bricks; free minus occupied (occupied wins).
+    std::vector<const uint8_t*> locals;
+    for (const Bitmap& b : free_bits) locals.push_back(b.bytes.get());
+    tbb::enumerable_thread_specific<std::vector<std::unique_ptr<MaskLeaf>>> free_leaves, occ_leaves;
+    tbb::parallel_for(tbb::blocked_range<int64_t>(0, box.nx / 8), [&](const auto& range) {
+        auto& my_free = free_leaves.local();
+        auto& my_occ = occ_leaves.local();
+        uint64_t occ[8], fre[8], tmp[8];
+        for (int64_t bx = range.begin() * 8; bx != range.end() * 8; bx += 8) {
+            for (int64_t by = 0; by < box.ny; by += 8) {
+                for (int64_t bz = 0; bz < box.nz; bz += 8) {
+                    GatherBrick(box, occupied_bits.bytes.get(), bx, by, bz, occ);
+                    uint64_t any_free = 0, any_occ = 0;
+                    std::memset(fre, 0, sizeof(fre));
+                    for (const uint8_t* local : locals) {
+                        GatherBrick(box, local, bx, by, bz, tmp);
+                        for (int w = 0; w < 8; ++w) fre[w] |= tmp[w];
+                    }
+                    for (int w = 0; w < 8; ++w) {
+                        fre[w] &= ~occ[w];
+                        any_free |= fre[w];
+                        any_occ |= occ[w];
+                    }
+                    const openvdb::Coord origin =
+                        box.lo + openvdb::Coord(static_cast<int32_t>(bx), static_cast<int32_t>(by),
+                                                static_cast<int32_t>(bz));
+                    const auto emit = [&origin](const uint64_t* words, auto& out) {
+                        auto leaf = std::make_unique<MaskLeaf>(origin);
+                        for (int w = 0; w < 8; ++w) {
+                            leaf->getValueMask().template getWord<uint64_t>(w) = words[w];
+                        }
+                        out.push_back(std::move(leaf));
+                    };
+                    if (any_free) emit(fre, my_free);
+                    if (any_occ) emit(occ, my_occ);
+                }
+            }
+        }
+    });
+    ScanMasks masks;
+    for (auto& leaves : free_leaves) {
+        for (auto& leaf : leaves) masks.free->addLeaf(leaf.release());
+    }
+    for (auto& leaves : occ_leaves) {
+        for (auto& leaf : leaves) masks.occupied->addLeaf(leaf.release());
+    }
+    return masks;
+}
+
+// Bounded-memory path for scans whose box is too large for a bitmap.
+ScanMasks MarkSparse(const PreparedScan& scan) {
+    const VoxelBox& box = scan.box;
+    tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, scan.rays.size(), kRayGrain),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(free_trees.local());
+                          for (size_t i = range.begin(); i != range.end(); ++i) {
+                              TraceRay(scan.rays[i], static_cast<uint64_t>(box.size()),
+                                       [&](int64_t pos) { acc.setValueOn(PosToCoord(box, pos)); });
+                          }
+                      });
+    ScanMasks masks;
+    for (const auto& tree : free_trees) masks.free->topologyUnion(tree);
+    openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(*masks.occupied);
+    for (const int64_t pos : scan.endpoint_pos) acc.setValueOn(PosToCoord(box, pos));
+    masks.free->topologyDifference(*masks.occupied);
+    return masks;
+}
+
+}  // namespace
+
+ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config) {
+    if (static_cast<uint64_t>(scan.box.size() / 8) <= config.dense_scratch_limit_bytes) {
+        return MarkDense(scan);
+    }
+    return MarkSparse(scan);
+}
+
+}  // namespace strata::integration::detail

@@ -1,0 +1,63 @@
+#pragma once
+// Private to the integrator: which voxels one scan saw free and occupied (ARCHITECTURE.md,
+// "Integration semantics"), marked into per-thread bitmaps over the scan's bounding box.
+
+#include <openvdb/openvdb.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "strata/integration/IntegrationConfig.hpp"
+
+namespace strata::integration::detail {
+
+/// The box of voxels a scan can touch, padded by one voxel and aligned to 8 (VDB leaves), so a
+/// brick of the box is exactly one leaf. `pos` values are linear indices into it, z fastest.
+struct VoxelBox {
+    openvdb::Coord lo;           // first voxel, multiple of 8 in each axis
+    int64_t nx = 0, ny = 0, nz = 0;  // extents, multiples of 8
+
+    [[nodiscard]] int64_t size() const { return nx * ny * nz; }
+    [[nodiscard]] int64_t Index(const openvdb::Coord& c) const {
+        return ((c.x() - lo.x()) * ny + (c.y() - lo.y())) * nz + (c.z() - lo.z());
+    }
+};
+
+/// One ray in voxel terms, ready for the DDA: the start index, per-axis step strides, and the
+/// parametric distances of OctoMap's computeRayKeys (tMax, tDelta, in metres).
+struct RaySetup {
+    int64_t start = 0;
+    int64_t stride[3] = {0, 0, 0};
+    double t_max[3] = {0, 0, 0};
+    double t_delta[3] = {0, 0, 0};
+    int32_t steps = 0;  // voxel boundaries crossed from the origin voxel to the end voxel
+};
+
+/// Endpoints and rays of one scan after filtering, in the map frame.
+struct PreparedScan {
+    VoxelBox box;
+    std::vector<RaySetup> rays;          // free-space rays (empty with points_only)
+    std::vector<int64_t> endpoint_pos;   // box index of every kept endpoint, scan order
+    std::vector<uint32_t> endpoint_point;  // index of that endpoint's point in the scan
+    size_t dropped = 0;                  // NaN/inf or closer than min_range
+    size_t clipped = 0;                  // longer than max_range: free space only
+};
+
+/// Filters points, computes the box and the rays. `points_map` are map-frame coordinates.
+[[nodiscard]] PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
+                                       const Eigen::Vector3d& origin_map, double voxel_size,
+                                       const IntegrationConfig& config);
+
+/// The free and occupied voxels of a scan as VDB masks, free minus occupied (occupied wins).
+struct ScanMasks {
+    openvdb::MaskTree::Ptr free = std::make_shared<openvdb::MaskTree>();
+    openvdb::MaskTree::Ptr occupied = std::make_shared<openvdb::MaskTree>();
+};
+
+/// Marks every ray with an exact 3D DDA (parallel over rays, thread-local bitmaps merged with OR).
+/// The result does not depend on the number of threads.
+[[nodiscard]] ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config);
+
+}  // namespace strata::integration::detail

@@ -1,0 +1,222 @@
+#include "strata/integration/Integrator.hpp"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+#include <tuple>
+
+namespace strata::integration {
+namespace {
+
+using Key = std::tuple<int, int, int>;
+constexpr float kValueTol = 1e-6f;
+
+std::set<Key> ActiveVoxels(const openvdb::MaskTree& tree) {
+    std::set<Key> out;
+    for (auto it = tree.cbeginValueOn(); it; ++it) {
+        out.insert({it.getCoord().x(), it.getCoord().y(), it.getCoord().z()});
+    }
+    return out;
+}
+
+core::Scan MakeScan(std::vector<Eigen::Vector3d> points, const Eigen::Vector3d& origin) {
+    core::Scan scan;
+    scan.points = std::move(points);
+    scan.T_world_sensor = Eigen::Translation3d(origin) * Eigen::Isometry3d::Identity();
+    for (auto& p : scan.points) p -= origin;  // points are given in the world, stored in sensor
+    return scan;
+}
+
+// A closed box room (5 x 4 x 3 m) seen from inside: points on its walls, seeded.
+core::Scan RoomScan(uint32_t seed, size_t n) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const Eigen::Vector3d half(2.5, 2.0, 1.5);
+    const Eigen::Vector3d centre(0.31, 0.17, 0.05);  // walls off the 0.1 m voxel faces
+    std::vector<Eigen::Vector3d> points;
+    for (size_t i = 0; i < n; ++i) {
+        Eigen::Vector3d d(u(rng), u(rng), u(rng));
+        const double t = (half.array() / d.array().abs()).minCoeff();  // hit the box from centre
+        points.push_back(centre + d * t);
+    }
+    return MakeScan(points, centre);
+}
+
+TEST(Integrator, HandCheckedRayCrossesExpectedVoxels) {
+    // 1 m voxels, ray from (0.5, 0.5, 0.5) to (3.5, 2.5, 0.5): y = 0.5 + 2/3 (x - 0.5) crosses
+    // x=1 (y=.83), y=1 (x=1.25), x=2 (y=1.5), y=2 (x=2.75), x=3 (end voxel).
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    const auto update = ComputeScanUpdate(
+        MakeScan({{3.5, 2.5, 0.5}}, {0.5, 0.5, 0.5}), map, IntegrationConfig{});
+    EXPECT_EQ(ActiveVoxels(*update.free),
+              (std::set<Key>{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {2, 1, 0}, {2, 2, 0}}));
+    EXPECT_EQ(ActiveVoxels(*update.occupied), (std::set<Key>{{3, 2, 0}}));
+
+    ApplyScanUpdate(update, map, IntegrationConfig{});
+    EXPECT_NEAR(map.occupancy->tree().getValue({1, 1, 0}), core::LogOdds(0.4), kValueTol);
+    EXPECT_NEAR(map.occupancy->tree().getValue({3, 2, 0}), core::LogOdds(0.7), kValueTol);
+    EXPECT_FALSE(map.occupancy->tree().isValueOn({3, 3, 0}));  // never seen: unknown
+    EXPECT_EQ(map.hits->tree().getValue({3, 2, 0}), 1);
+}
+
+TEST(Integrator, NegativeCoordinatesFollowFloorConvention) {
+    // Voxel (i) covers [i*s, (i+1)*s): -0.05 at 0.1 m is voxel -1, as in OctoMap.
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    const auto update = ComputeScanUpdate(MakeScan({{-0.05, -0.15, 0.05}}, {0.05, 0.05, 0.05}),
+                                          map, IntegrationConfig{});
+    EXPECT_EQ(ActiveVoxels(*update.occupied), (std::set<Key>{{-1, -2, 0}}));
+}
+
+TEST(Integrator, UpdatesEveryVoxelAtMostOncePerScan) {
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    Integrator integrator(map, IntegrationConfig{});
+    // Three identical rays and one parallel ray through the same voxels.
+    integrator.Integrate(MakeScan({{5.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, {5.5, 0.5, 0.5},
+                                   {5.6, 0.6, 0.5}},
+                                  {0.5, 0.5, 0.5}));
+    EXPECT_NEAR(map.occupancy->tree().getValue({2, 0, 0}), core::LogOdds(0.4), kValueTol);
+    EXPECT_NEAR(map.occupancy->tree().getValue({5, 0, 0}), core::LogOdds(0.7), kValueTol);
+    EXPECT_EQ(map.hits->tree().getValue({5, 0, 0}), 4);  // hits count points, not updates
+}
+
+TEST(Integrator, OccupiedWinsOverFreeWithinAScan) {
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    Integrator integrator(map, IntegrationConfig{});
+    // The first ray ends in voxel 3, the second passes through it to voxel 6.
+    integrator.Integrate(MakeScan({{3.5, 0.5, 0.5}, {6.5, 0.5, 0.5}}, {0.5, 0.5, 0.5}));
+    EXPECT_NEAR(map.occupancy->tree().getValue({3, 0, 0}), core::LogOdds(0.7), kValueTol);
+    EXPECT_NEAR(map.occupancy->tree().getValue({4, 0, 0}), core::LogOdds(0.4), kValueTol);
+}
+
+TEST(Integrator, MaxRangeRayClearsFreeSpaceWithoutHit) {
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    IntegrationConfig config;
+    config.max_range_m = 5.0;
+    Integrator integrator(map, config);
+    const auto update = integrator.Integrate(MakeScan({{10.5, 0.5, 0.5}}, {0.5, 0.5, 0.5}));
+    EXPECT_EQ(update.clipped, 1u);
+    EXPECT_TRUE(update.occupied->empty());
+    // Clipped end at x = 5.5 (voxel 5): voxels 0..4 free, 5 and beyond unknown, no hit anywhere.
+    EXPECT_EQ(ActiveVoxels(*update.free),
+              (std::set<Key>{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}, {4, 0, 0}}));
+    EXPECT_FALSE(map.occupancy->tree().isValueOn({5, 0, 0}));
+    EXPECT_FALSE(map.occupancy->tree().isValueOn({10, 0, 0}));
+    EXPECT_EQ(map.hits->activeVoxelCount(), 0u);
+}
+
+TEST(Integrator, DropsInvalidAndTooClosePoints) {
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    IntegrationConfig config;
+    config.min_range_m = 1.0;
+    const double nan = std::nan("");
+    const auto update = ComputeScanUpdate(
+        MakeScan({{nan, 0, 0}, {0.6, 0.5, 0.5}, {INFINITY, 1, 1}, {4.5, 0.5, 0.5}},
+                 {0.5, 0.5, 0.5}),
+        map, config);
+    EXPECT_EQ(update.dropped, 3u);
+    EXPECT_EQ(ActiveVoxels(*update.occupied), (std::set<Key>{{4, 0, 0}}));
+}
+
+TEST(Integrator, ClampsLogOddsLikeOctomap) {
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    Integrator integrator(map, IntegrationConfig{});
+    const auto scan = MakeScan({{4.5, 0.5, 0.5}}, {0.5, 0.5, 0.5});
+    for (int i = 0; i < 20; ++i) integrator.Integrate(scan);
+    EXPECT_NEAR(map.occupancy->tree().getValue({4, 0, 0}), core::LogOdds(0.971), kValueTol);
+    EXPECT_NEAR(map.occupancy->tree().getValue({1, 0, 0}), core::LogOdds(0.1192), kValueTol);
+}
+
+TEST(Integrator, LabelFlipsOnlyWhenOutweighed) {
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    Integrator integrator(map, IntegrationConfig{});
+    auto scan = MakeScan({{4.5, 0.5, 0.5}}, {0.5, 0.5, 0.5});
+    const auto vote = [&](core::SemanticClass c, int times) {
+        scan.labels = {c};
+        for (int i = 0; i < times; ++i) integrator.Integrate(scan);
+    };
+    const openvdb::Coord v(4, 0, 0);
+    vote(core::SemanticClass::kVehicle, 3);
+    vote(core::SemanticClass::kBuilding, 2);
+    EXPECT_EQ(map.label->tree().getValue(v), static_cast<int>(core::SemanticClass::kVehicle));
+    EXPECT_NEAR(map.label_weight->tree().getValue(v), 1.0f, kValueTol);
+    vote(core::SemanticClass::kBuilding, 1);  // a tie keeps the label
+    EXPECT_EQ(map.label->tree().getValue(v), static_cast<int>(core::SemanticClass::kVehicle));
+    vote(core::SemanticClass::kBuilding, 1);
+    EXPECT_EQ(map.label->tree().getValue(v), static_cast<int>(core::SemanticClass::kBuilding));
+    EXPECT_NEAR(map.label_weight->tree().getValue(v), 1.0f, kValueTol);
+}
+
+void ExpectSameGrids(const core::VoxelMap& a, const core::VoxelMap& b) {
+    ASSERT_EQ(a.occupancy->activeVoxelCount(), b.occupancy->activeVoxelCount());
+    auto acc = b.occupancy->getConstAccessor();
+    for (auto it = a.occupancy->cbeginValueOn(); it; ++it) {
+        ASSERT_TRUE(acc.isValueOn(it.getCoord()));
+        ASSERT_EQ(acc.getValue(it.getCoord()), *it) << it.getCoord();
+    }
+    EXPECT_EQ(a.hits->activeVoxelCount(), b.hits->activeVoxelCount());
+}
+
+core::VoxelMap IntegrateRoom(const IntegrationConfig& config) {
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    Integrator integrator(map, config);
+    for (uint32_t seed = 1; seed <= 3; ++seed) integrator.Integrate(RoomScan(seed, 20000));
+    return map;
+}
+
+TEST(Integrator, ResultDoesNotDependOnThreadCount) {
+    core::VoxelMap one, four;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = IntegrateRoom(IntegrationConfig{});
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 4);
+        four = IntegrateRoom(IntegrationConfig{});
+    }
+    EXPECT_GT(one.occupancy->activeVoxelCount(), 10000u);
+    ExpectSameGrids(one, four);
+}
+
+TEST(Integrator, SparseMarkingMatchesDenseMarking) {
+    IntegrationConfig sparse;
+    sparse.dense_scratch_limit_bytes = 0;  // force the bounded-memory path
+    ExpectSameGrids(IntegrateRoom(IntegrationConfig{}), IntegrateRoom(sparse));
+}
+
+TEST(Integrator, PointsOnlyMarksEndpointsWithoutFreeSpace) {
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    IntegrationConfig config;
+    config.points_only = true;
+    const auto update = ComputeScanUpdate(RoomScan(7, 5000), map, config);
+    EXPECT_TRUE(update.free->empty());
+    EXPECT_GT(update.occupied->activeVoxelCount(), 1000u);
+}
+
+TEST(Integrator, GeoreferencedOriginKeepsPrecision) {
+    // Far from the origin (UTM-like), a map with a matching origin sees the same voxels.
+    const Eigen::Vector3d utm(500000.0, 4500000.0, 100.0);
+    core::VoxelMap local = core::VoxelMap::Create(0.1);
+    core::VoxelMap geo = core::VoxelMap::Create(0.1, utm);
+    core::Scan scan = RoomScan(3, 5000);
+    const auto a = ComputeScanUpdate(scan, local, IntegrationConfig{});
+    scan.T_world_sensor.pretranslate(utm);
+    const auto b = ComputeScanUpdate(scan, geo, IntegrationConfig{});
+    EXPECT_EQ(ActiveVoxels(*a.occupied), ActiveVoxels(*b.occupied));
+    EXPECT_EQ(ActiveVoxels(*a.free), ActiveVoxels(*b.free));
+}
+
+TEST(Integrator, RejectsBadConfigAndMismatchedLabels) {
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    IntegrationConfig bad;
+    bad.max_range_m = -1.0;
+    EXPECT_THROW(Integrator(map, bad), std::invalid_argument);
+    core::Scan scan = RoomScan(1, 10);
+    scan.labels.resize(3);
+    EXPECT_THROW((void)ComputeScanUpdate(scan, map, IntegrationConfig{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace strata::integration
