@@ -1,7 +1,7 @@
 // Integration benchmark: our Integrator against OctoMap's insertPointCloud on the same points,
 // in the same process (issue: the spine). Prints one markdown table row per (dataset, voxel size).
 //
-//   bench_integration [DATA_DIR] [--scans N] [--voxel S ...]
+//   bench_integration [DATA_DIR] [--scans N] [--voxel S ...] [--strata-only]
 //
 // OctoMap is compiled here without OpenMP, so it runs on one thread, as it does by default.
 #include <tbb/global_control.h>
@@ -100,10 +100,13 @@ int main(int argc, char** argv) {
     fs::path data = STRATA_DATA_DIR;
     size_t max_scans = 1000;
     std::vector<double> voxels;
+    bool with_octomap = true;  // --strata-only: for profiling our side alone
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--scans" && i + 1 < argc) {
             max_scans = std::stoul(argv[++i]);
+        } else if (a == "--strata-only") {
+            with_octomap = false;
         } else if (a == "--voxel" && i + 1 < argc) {
             voxels.push_back(std::stod(argv[++i]));
         } else {
@@ -125,7 +128,7 @@ int main(int argc, char** argv) {
         size_t n_points = 0;
         const auto scans = LoadScans(dir, max_scans, n_points);
         for (const double voxel : voxels) {
-            const Run octo = RunOctomap(scans, voxel, max_range);
+            const Run octo = with_octomap ? RunOctomap(scans, voxel, max_range) : Run{};
             const Run one = RunStrata(scans, voxel, max_range, 1);
             const Run two = RunStrata(scans, voxel, max_range, 2);
             const double pts_per_scan = static_cast<double>(n_points) / scans.size();

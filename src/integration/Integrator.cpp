@@ -1,10 +1,9 @@
 #include "strata/integration/Integrator.hpp"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
 
 #include "ApplyUpdate.hpp"
+#include "RadixSort.hpp"
 #include "RayMarking.hpp"
 
 namespace strata::integration {
@@ -20,7 +19,9 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
         keys[i] = (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
                   static_cast<uint64_t>(label);
     }
-    tbb::parallel_sort(keys.begin(), keys.end());
+    int key_bits = 8;  // class id
+    while ((int64_t{1} << (key_bits - 8)) < prepared.box.size()) ++key_bits;
+    detail::RadixSort(keys, key_bits);
     std::vector<EndpointGroup> groups;
     const detail::VoxelBox& box = prepared.box;
     for (size_t i = 0; i < keys.size();) {

@@ -31,33 +31,40 @@ struct Bitmap {
 
 // The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel and every voxel up to, not
 // including, the end voxel. Terminating on the crossing count replaces OctoMap's key comparison.
-// `in_box` bounds every write, whatever the rounding does.
+// The box check bounds every write, whatever the rounding does.
 template <typename MarkFn>
 inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark) {
+    if (ray.steps == 0) return;  // origin and end share a voxel: no free cells
+    // Locals, not members: the marks are byte stores, which may alias anything in memory, so
+    // values read through `ray` would be reloaded after every store.
     int64_t pos = ray.start;
-    mark(pos);
+    const int64_t s0 = ray.stride[0], s1 = ray.stride[1], s2 = ray.stride[2];
+    const double d0 = ray.t_delta[0], d1 = ray.t_delta[1], d2 = ray.t_delta[2];
     double t0 = ray.t_max[0], t1 = ray.t_max[1], t2 = ray.t_max[2];
-    for (int32_t s = 1; s < ray.steps; ++s) {
+    mark(pos);
+    for (int32_t s = 1, n = ray.steps; s < n; ++s) {
         // Same tie-breaking as OctoMap: x before z, y before z, y before x only when strictly less.
         if (t0 < t1) {
             if (t0 < t2) {
-                t0 += ray.t_delta[0];
-                pos += ray.stride[0];
+                t0 += d0;
+                pos += s0;
             } else {
-                t2 += ray.t_delta[2];
-                pos += ray.stride[2];
+                t2 += d2;
+                pos += s2;
             }
         } else if (t1 < t2) {
-            t1 += ray.t_delta[1];
-            pos += ray.stride[1];
+            t1 += d1;
+            pos += s1;
         } else {
-            t2 += ray.t_delta[2];
-            pos += ray.stride[2];
+            t2 += d2;
+            pos += s2;
         }
         if (static_cast<uint64_t>(pos) >= box_size) return;
         mark(pos);
     }
 }
+
+size_t RayCount(const PreparedScan& scan) { return scan.points_only ? 0 : scan.ends.size(); }
 
 openvdb::Coord PosToCoord(const VoxelBox& box, int64_t pos) {
     const int64_t z = pos % box.nz;
@@ -84,12 +91,14 @@ ScanMasks MarkDense(const PreparedScan& scan) {
     const VoxelBox& box = scan.box;
     const auto n_bytes = static_cast<size_t>(box.size() / 8);
     tbb::enumerable_thread_specific<Bitmap> free_bits([n_bytes] { return Bitmap(n_bytes); });
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, scan.rays.size(), kRayGrain),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
-                          Bitmap& bits = free_bits.local();
+                          uint8_t* const bits = free_bits.local().bytes.get();
+                          const auto mark = [bits](int64_t pos) {
+                              bits[pos >> 3] |= static_cast<uint8_t>(1u << (pos & 7));
+                          };
                           for (size_t i = range.begin(); i != range.end(); ++i) {
-                              TraceRay(scan.rays[i], static_cast<uint64_t>(box.size()),
-                                       [&bits](int64_t pos) { bits.Set(pos); });
+                              TraceRay(SetupRay(scan, i), static_cast<uint64_t>(box.size()), mark);
                           }
                       });
     Bitmap occupied_bits(n_bytes);
@@ -148,11 +157,11 @@ ScanMasks MarkDense(const PreparedScan& scan) {
 ScanMasks MarkSparse(const PreparedScan& scan) {
     const VoxelBox& box = scan.box;
     tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, scan.rays.size(), kRayGrain),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
                           openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(free_trees.local());
                           for (size_t i = range.begin(); i != range.end(); ++i) {
-                              TraceRay(scan.rays[i], static_cast<uint64_t>(box.size()),
+                              TraceRay(SetupRay(scan, i), static_cast<uint64_t>(box.size()),
                                        [&](int64_t pos) { acc.setValueOn(PosToCoord(box, pos)); });
                           }
                       });

@@ -35,20 +35,31 @@ struct RaySetup {
     int32_t steps = 0;  // voxel boundaries crossed from the origin voxel to the end voxel
 };
 
+/// What each point of a scan contributes.
+enum class PointKind : uint8_t { kDropped, kHit, kClipped };
+
 /// Endpoints and rays of one scan after filtering, in the map frame.
 struct PreparedScan {
     VoxelBox box;
-    std::vector<RaySetup> rays;          // free-space rays (empty with points_only)
-    std::vector<int64_t> endpoint_pos;   // box index of every kept endpoint, scan order
-    std::vector<uint32_t> endpoint_point;  // index of that endpoint's point in the scan
+    Eigen::Vector3d origin;             // sensor origin, map frame
+    openvdb::Coord key_origin;
+    double voxel_size = 0.0;
+    bool points_only = false;
+    std::vector<Eigen::Vector3d> ends;  // per point: the point, or the ray clipped to max range
+    std::vector<PointKind> kinds;       // per point
+    std::vector<int64_t> endpoint_pos;   // box index of every hit, scan order
+    std::vector<uint32_t> endpoint_point;  // index of that hit's point in the scan
     size_t dropped = 0;                  // NaN/inf or closer than min_range
     size_t clipped = 0;                  // longer than max_range: free space only
 };
 
-/// Filters points, computes the box and the rays. `points_map` are map-frame coordinates.
+/// Filters points, computes the box and the endpoint voxels (parallel over points).
 [[nodiscard]] PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                                        const Eigen::Vector3d& origin_map, double voxel_size,
                                        const IntegrationConfig& config);
+
+/// OctoMap's initialisation of tMax/tDelta for the ray of point `i`.
+[[nodiscard]] RaySetup SetupRay(const PreparedScan& scan, size_t i);
 
 /// The free and occupied voxels of a scan as VDB masks, free minus occupied (occupied wins).
 struct ScanMasks {
