@@ -1,0 +1,55 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "strata/core/Labels.hpp"
+
+namespace strata::io {
+
+/// @brief An 8-bit RGB raster, row-major from the top-left pixel, for the pictures strata draws
+/// (top-down maps, slant maps, change maps).
+class RgbImage {
+public:
+    RgbImage() = default;
+    /// @brief A width x height image filled with `fill`; throws std::invalid_argument unless both
+    /// sizes are positive.
+    RgbImage(int width, int height, core::Rgb fill = {0, 0, 0});
+
+    [[nodiscard]] int width() const { return width_; }
+    [[nodiscard]] int height() const { return height_; }
+    [[nodiscard]] const std::vector<uint8_t>& pixels() const { return pixels_; }
+    /// @brief True when (x, y) lies inside the image.
+    [[nodiscard]] bool Contains(int x, int y) const {
+        return x >= 0 && y >= 0 && x < width_ && y < height_;
+    }
+    /// @brief The pixel at column x, row y (unchecked: the caller keeps (x, y) inside).
+    [[nodiscard]] core::Rgb At(int x, int y) const;
+    /// @brief Sets the pixel at column x, row y (unchecked).
+    void Set(int x, int y, core::Rgb color);
+    /// @brief Fills the rectangle [x0, x0 + w) x [y0, y0 + h), clipped to the image.
+    void FillRect(int x0, int y0, int w, int h, core::Rgb color);
+
+private:
+    friend RgbImage ReadPng(const std::filesystem::path& path);
+    int width_ = 0;
+    int height_ = 0;
+    std::vector<uint8_t> pixels_;  ///< 3 bytes per pixel
+};
+
+/// @brief Draws a labelled scale bar ("50 m") in the bottom-left corner: a round length
+/// (1, 2 or 5 x 10^k m) about a quarter of the image wide. Does nothing on images too small for it.
+/// @param meters_per_pixel ground size of one pixel; must be positive.
+void DrawScaleBar(RgbImage& image, double meters_per_pixel);
+
+/// @brief Writes an 8-bit RGB PNG, all or nothing (temporary file + rename).
+/// @note Throws std::runtime_error naming `path` on any I/O problem, std::invalid_argument for an
+/// empty image.
+void WritePng(const RgbImage& image, const std::filesystem::path& path);
+
+/// @brief Reads a PNG of any colour type as 8-bit RGB (alpha dropped, grey expanded); throws
+/// std::runtime_error naming `path` when it cannot be read or decoded.
+[[nodiscard]] RgbImage ReadPng(const std::filesystem::path& path);
+
+}  // namespace strata::io

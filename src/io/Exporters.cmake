@@ -1,0 +1,6 @@
+# Exporters of the io module (VDB bundle, OctoMap .bt/.ot, PLY, top-down PNG); included by
+# CMakeLists.txt next to Readers.cmake.
+list(APPEND STRATA_IO_SOURCES
+  AtomicFile.cpp
+  Image.cpp
+  VdbExport.cpp)

@@ -1,0 +1,3 @@
+# Tests of the io exporters; included by CMakeLists.txt next to Readers.cmake.
+list(APPEND STRATA_IO_TESTS
+  TestVdbExport.cpp)
