@@ -3,4 +3,7 @@
 list(APPEND STRATA_IO_SOURCES
   AtomicFile.cpp
   Image.cpp
+  OctomapExport.cpp
+  PlyExport.cpp
+  PngExport.cpp
   VdbExport.cpp)
