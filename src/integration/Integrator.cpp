@@ -1,5 +1,8 @@
 #include "strata/integration/Integrator.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 
 #include "ApplyUpdate.hpp"
@@ -53,7 +56,12 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
     std::vector<Eigen::Vector3d> points_map(scan.points.size());
     const Eigen::Isometry3d T_map_sensor =
         Eigen::Translation3d(-map.origin) * scan.T_world_sensor;
-    for (size_t i = 0; i < scan.points.size(); ++i) points_map[i] = T_map_sensor * scan.points[i];
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, points_map.size(), 8192),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i) {
+                              points_map[i] = T_map_sensor * scan.points[i];
+                          }
+                      });
 
     const detail::PreparedScan prepared =
         detail::PrepareScan(points_map, T_map_sensor.translation(), map.voxel_size, config);
