@@ -1,0 +1,41 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "strata/sim/GroundTruth.hpp"
+#include "strata/sim/SceneSpec.hpp"
+
+namespace strata::sim {
+
+/// @brief Triangles of one object part that share a class (world frame, metres).
+struct Mesh {
+    std::vector<Eigen::Vector3f> vertices;
+    std::vector<std::array<uint32_t, 3>> triangles;
+    uint16_t label = 0;     ///< SemanticKITTI raw class
+    uint16_t instance = 0;  ///< object id
+    float reflectivity = 0.3F;
+    bool is_static = true;  ///< part of the ground-truth static surface (vehicles are not)
+
+    /// @brief Appends another mesh's triangles (same class assumed).
+    void Append(const Mesh& other);
+    [[nodiscard]] double Area() const;
+};
+
+/// @brief A scene ready to ray trace: the meshes of one session and its ground truth.
+struct Scene {
+    std::vector<Mesh> meshes;
+    GroundTruth truth;  ///< world frame
+    Eigen::AlignedBox3d bounds;
+
+    [[nodiscard]] size_t TriangleCount() const;
+};
+
+/// @brief Builds the meshes and ground truth of one session of a scene (edits of sessions
+/// 0..session applied). Deterministic: the same spec gives the same triangles.
+/// @note Throws std::invalid_argument for a session index out of range.
+[[nodiscard]] Scene BuildScene(const SceneSpec& spec, size_t session);
+
+}  // namespace strata::sim

@@ -1,0 +1,65 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "strata/sim/ScenePicture.hpp"
+#include "strata/sim/SceneSpec.hpp"
+
+namespace strata::sim {
+
+/// @brief Options of SimulateSceneToSequence; the scene file decides everything else.
+struct SimulateConfig {
+    std::string sensor;                   ///< "" = the scene's sensor (hdl64, vlp16, os1-64, ...)
+    std::optional<uint64_t> seed;         ///< noise seed; unset = the scene's seed
+    int max_scans = 0;                    ///< > 0 caps the scans of every session
+    bool motion = false;                  ///< sensor motion during each sweep (raw, not deskewed)
+    std::optional<double> range_noise_m;  ///< unset = the sensor's default (0.02 m)
+    double surface_spacing_m = 0.1;       ///< spacing of the static surface sample
+    bool mark_observed = true;            ///< flag surface points in line of sight of the path
+    bool write_picture = true;            ///< picture.png (top-down, by class) in each sequence
+    PictureConfig picture;
+
+    /// @brief Throws std::invalid_argument for an unknown sensor or out-of-range values.
+    void Validate() const;
+};
+
+/// @brief What was written for one session.
+struct SessionReport {
+    std::string name;
+    std::filesystem::path dir;
+    size_t scans = 0, points = 0, rays = 0, triangles = 0;
+    size_t walls = 0, vehicles = 0, edits = 0, surface_points = 0;
+    double trace_seconds = 0.0;  ///< wall-clock time spent ray tracing sweeps
+};
+
+struct SimulateReport {
+    std::vector<SessionReport> sessions;
+};
+
+/// @brief Called after each scan with (scans done, scans in total).
+using SimulateProgress = std::function<void(size_t, size_t)>;
+
+/// @brief Simulates every session of a scene into SemanticKITTI sequences with ground truth:
+/// `out_dir` itself for a one-session scene, else `out_dir/session_<k>` for each session.
+/// @note Throws std::invalid_argument for a bad config or scene, std::runtime_error naming the
+/// file on I/O failure. Uses all TBB threads; limit them in the caller.
+[[nodiscard]] SimulateReport SimulateSceneToSequence(const SceneSpec& scene,
+                                                     const std::filesystem::path& out_dir,
+                                                     const SimulateConfig& config = {},
+                                                     const SimulateProgress& progress = {});
+/// @brief Same, reading the scene file first (LoadSceneSpec).
+[[nodiscard]] SimulateReport SimulateSceneToSequence(const std::filesystem::path& scene_file,
+                                                     const std::filesystem::path& out_dir,
+                                                     const SimulateConfig& config = {},
+                                                     const SimulateProgress& progress = {});
+
+/// @brief A small built-in street (facades, parked cars, trees, 10 scans) for demos without a
+/// scene file or real data.
+[[nodiscard]] SceneSpec DemoStreetScene();
+
+}  // namespace strata::sim

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "strata/sim/Scene.hpp"
+
+namespace strata::sim {
+
+class Simulator;
+
+/// @brief A dense point sample of the static surfaces of a scene (vehicles excluded, the
+/// ground under them included), for Chamfer and F-score evaluation. World frame.
+struct SurfaceSample {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<uint16_t> labels;     ///< SemanticKITTI raw class
+    std::vector<uint16_t> instances;  ///< object id
+    std::vector<uint8_t> observed;    ///< 1 when in line of sight of a scan position, else 0
+};
+
+/// @brief Samples every static mesh uniformly by area, about one point per spacing_m^2.
+/// Deterministic for a seed. Throws std::invalid_argument unless spacing_m > 0.
+[[nodiscard]] SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m,
+                                                uint64_t seed);
+
+/// @brief Sets `observed` for points with a free line of sight from at least one origin within
+/// max_range_m (the sensor's field of view is not modelled). Parallel (TBB).
+void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
+                  const std::vector<Eigen::Vector3d>& origins_world, double max_range_m);
+
+/// @brief Writes a binary little-endian PLY (x y z float, label instance ushort, observed
+/// uchar), points mapped by T_out_world. Throws std::runtime_error naming the file on failure.
+void WriteSurfacePly(const std::filesystem::path& path, const SurfaceSample& sample,
+                     const Eigen::Isometry3d& T_out_world = Eigen::Isometry3d::Identity());
+
+}  // namespace strata::sim

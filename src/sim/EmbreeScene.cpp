@@ -1,0 +1,142 @@
+#include "EmbreeScene.hpp"
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace strata::sim {
+namespace {
+
+[[noreturn]] void ThrowEmbree(RTCError code, const std::string& what) {
+    throw std::runtime_error("Embree: " + what + " (error " + std::to_string(int(code)) + ")");
+}
+
+}  // namespace
+
+EmbreeScene::EmbreeScene(const std::vector<Mesh>& meshes) {
+    device_ = rtcNewDevice("verbose=0");
+    if (device_ == nullptr) ThrowEmbree(rtcGetDeviceError(nullptr), "cannot create a device");
+    scene_ = rtcNewScene(device_);
+    if (scene_ == nullptr) {
+        Fail("cannot create a scene");
+    }
+    // Built once and queried many times: spend the build time on a better BVH.
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        const Mesh& m = meshes[i];
+        if (m.triangles.empty()) continue;
+        RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                              RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                              m.vertices.size()));
+        auto* t = static_cast<uint32_t*>(
+            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(uint32_t), m.triangles.size()));
+        if (v == nullptr || t == nullptr) {
+            rtcReleaseGeometry(geom);
+            Fail("cannot allocate geometry buffers");
+        }
+        for (size_t k = 0; k < m.vertices.size(); ++k) {
+            std::memcpy(v + 3 * k, m.vertices[k].data(), 3 * sizeof(float));
+        }
+        std::memcpy(t, m.triangles.data(), m.triangles.size() * 3 * sizeof(uint32_t));
+        rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(scene_, geom, static_cast<unsigned>(i));
+        rtcReleaseGeometry(geom);  // the scene holds its own reference
+    }
+    rtcCommitScene(scene_);
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) Fail("cannot build the scene");
+}
+
+EmbreeScene::~EmbreeScene() { Release(); }
+
+EmbreeScene::EmbreeScene(EmbreeScene&& other) noexcept
+    : device_(std::exchange(other.device_, nullptr)),
+      scene_(std::exchange(other.scene_, nullptr)) {}
+
+EmbreeScene& EmbreeScene::operator=(EmbreeScene&& other) noexcept {
+    if (this != &other) {
+        Release();
+        device_ = std::exchange(other.device_, nullptr);
+        scene_ = std::exchange(other.scene_, nullptr);
+    }
+    return *this;
+}
+
+void EmbreeScene::Fail(const std::string& what) {
+    const RTCError code = rtcGetDeviceError(device_);
+    Release();
+    ThrowEmbree(code, what);
+}
+
+void EmbreeScene::Release() noexcept {
+    if (scene_ != nullptr) rtcReleaseScene(scene_);
+    if (device_ != nullptr) rtcReleaseDevice(device_);
+    scene_ = nullptr;
+    device_ = nullptr;
+}
+
+bool EmbreeScene::Intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                            float t_near, float t_far, Hit& hit) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray.org_x = origin.x();
+    rh.ray.org_y = origin.y();
+    rh.ray.org_z = origin.z();
+    rh.ray.dir_x = direction.x();
+    rh.ray.dir_y = direction.y();
+    rh.ray.dir_z = direction.z();
+    rh.ray.tnear = t_near;
+    rh.ray.tfar = t_far;
+    rh.ray.time = 0.0F;
+    rh.ray.mask = 0xFFFFFFFFU;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene_, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit.t = rh.ray.tfar;
+    hit.normal = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+    hit.geometry = rh.hit.geomID;
+    return true;
+}
+
+void EmbreeScene::Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3f* direction,
+                             int count, float t_far, Hit* hits) const {
+    alignas(32) int valid[8];
+    alignas(32) RTCRayHit8 rh;
+    for (int i = 0; i < 8; ++i) {
+        const bool on = i < count;
+        valid[i] = on ? -1 : 0;
+        const Eigen::Vector3f d = on ? direction[i] : Eigen::Vector3f::UnitX();
+        rh.ray.org_x[i] = origin.x();
+        rh.ray.org_y[i] = origin.y();
+        rh.ray.org_z[i] = origin.z();
+        rh.ray.dir_x[i] = d.x();
+        rh.ray.dir_y[i] = d.y();
+        rh.ray.dir_z[i] = d.z();
+        rh.ray.tnear[i] = 0.0F;
+        rh.ray.tfar[i] = t_far;
+        rh.ray.time[i] = 0.0F;
+        rh.ray.mask[i] = 0xFFFFFFFFU;
+        rh.ray.id[i] = static_cast<unsigned>(i);
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect8(valid, scene_, &context, &rh);
+    for (int i = 0; i < count; ++i) {
+        hits[i].geometry = rh.hit.geomID[i];
+        hits[i].t = rh.ray.tfar[i];
+        hits[i].normal = Eigen::Vector3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]);
+    }
+}
+
+}  // namespace strata::sim

@@ -1,0 +1,146 @@
+#include "strata/sim/SimulateScene.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+#include "strata/sim/SequenceWriter.hpp"
+#include "strata/sim/Simulator.hpp"
+#include "strata/sim/StaticSurface.hpp"
+#include "strata/sim/Trajectory.hpp"
+
+namespace strata::sim {
+namespace {
+
+SensorModel MakeSensor(const SceneSpec& scene, const SimulateConfig& config) {
+    SensorModel sensor =
+        SensorModel::FromName(config.sensor.empty() ? scene.sensor : config.sensor);
+    if (config.range_noise_m) sensor.range_noise_m = *config.range_noise_m;
+    sensor.Validate();
+    return sensor;
+}
+
+// Indoors (something above the first pose) the picture is cut just above the sensor, so that
+// ceilings do not hide the floor.
+PictureConfig PictureFor(const Simulator& simulator, const std::vector<ScanPose>& poses,
+                         PictureConfig picture) {
+    if (!std::isnan(picture.cut_z) || poses.empty()) return picture;
+    const Eigen::Vector3d start = poses.front().T_world_sensor.translation();
+    if (simulator.CastRay(start, Eigen::Vector3d::UnitZ(), 30.0)) {
+        double top = start.z();
+        for (const ScanPose& p : poses) top = std::max(top, p.T_world_sensor.translation().z());
+        picture.cut_z = top + 0.5;
+    }
+    return picture;
+}
+
+SessionReport SimulateSession(const SceneSpec& spec, size_t s, const std::filesystem::path& dir,
+                              const SimulateConfig& config, const SensorModel& sensor,
+                              const std::function<void()>& scan_done) {
+    const SessionSpec& session = spec.sessions[s];
+    Scene scene = BuildScene(spec, s);
+    const Simulator simulator(scene);
+    TrajectorySpec trajectory = session.trajectory;
+    if (config.max_scans > 0)
+        trajectory.max_scans = std::min(trajectory.max_scans, config.max_scans);
+    const std::vector<ScanPose> poses = PlanScanPoses(trajectory, simulator, sensor.rate_hz);
+    const Eigen::Isometry3d T_session_world = session.T_world_session.inverse();
+    const uint64_t seed = config.seed.value_or(spec.seed);
+
+    SessionReport report;
+    report.name = session.name;
+    report.dir = dir;
+    report.triangles = scene.TriangleCount();
+    SequenceWriter writer(dir);
+    for (size_t k = 0; k < poses.size(); ++k) {
+        SweepRequest request;
+        request.T_world_sensor = poses[k].T_world_sensor;
+        if (config.motion) request.T_world_sensor_end = poses[k].T_world_sensor_end;
+        request.seed = seed;
+        request.scan_index = (uint64_t(s) << 32) | k;
+        request.time_s = poses[k].time_s;
+        const auto start = std::chrono::steady_clock::now();
+        const SimulatedScan scan = simulator.SimulateSweep(request, sensor);
+        report.trace_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        writer.Add(scan, T_session_world * poses[k].T_world_sensor);
+        report.points += scan.scan.points.size();
+        report.rays += scan.rays;
+        if (scan_done) scan_done();
+    }
+    writer.Finish();
+    report.scans = writer.scans();
+    // Ground truth: the static surface sample, then ground_truth.json beside the scans.
+    SurfaceSample surface = SampleStaticSurface(scene, config.surface_spacing_m, spec.seed);
+    if (config.mark_observed) {
+        std::vector<Eigen::Vector3d> origins;
+        for (const ScanPose& p : poses) origins.push_back(p.T_world_sensor.translation());
+        MarkObserved(surface, simulator, origins, sensor.max_range_m);
+    }
+    GroundTruth& truth = scene.truth;
+    WriteSurfacePly(dir / truth.static_surface, surface, T_session_world);
+    truth.sensor = sensor.name;
+    truth.seed = seed;
+    truth.motion = config.motion;
+    truth.range_noise_m = sensor.range_noise_m;
+    truth.scans = report.scans;
+    WriteGroundTruth(dir / "ground_truth.json", truth);
+    if (config.write_picture) {
+        const Picture picture = RenderScenePicture(scene, simulator, poses,
+                                                   PictureFor(simulator, poses, config.picture));
+        WritePicturePng(dir / "picture.png", picture);
+    }
+    report.walls = truth.walls.size();
+    report.vehicles = truth.vehicles.size();
+    report.edits = truth.edits.size();
+    report.surface_points = surface.points.size();
+    return report;
+}
+
+}  // namespace
+
+void SimulateConfig::Validate() const {
+    if (!sensor.empty()) (void)SensorModel::FromName(sensor);
+    if (max_scans < 0) throw std::invalid_argument("max_scans must be >= 0");
+    if (range_noise_m && !(*range_noise_m >= 0.0)) {
+        throw std::invalid_argument("range noise must be >= 0");
+    }
+    if (!(surface_spacing_m >= 0.01)) {
+        throw std::invalid_argument("surface spacing must be at least 0.01 m");
+    }
+    picture.Validate();
+}
+
+SimulateReport SimulateSceneToSequence(const SceneSpec& scene, const std::filesystem::path& out_dir,
+                                       const SimulateConfig& config,
+                                       const SimulateProgress& progress) {
+    config.Validate();
+    scene.Validate();
+    const SensorModel sensor = MakeSensor(scene, config);
+    size_t total = 0, done = 0;
+    for (const SessionSpec& s : scene.sessions) {
+        const int cap = config.max_scans > 0 ? std::min(config.max_scans, s.trajectory.max_scans)
+                                             : s.trajectory.max_scans;
+        total += static_cast<size_t>(cap);  // an upper bound: a short path ends earlier
+    }
+    const auto scan_done = [&]() {
+        if (progress) progress(++done, total);
+    };
+    SimulateReport report;
+    for (size_t s = 0; s < scene.sessions.size(); ++s) {
+        const std::filesystem::path dir =
+            scene.sessions.size() == 1 ? out_dir : out_dir / ("session_" + std::to_string(s));
+        report.sessions.push_back(SimulateSession(scene, s, dir, config, sensor, scan_done));
+    }
+    if (progress) progress(total, total);
+    return report;
+}
+
+SimulateReport SimulateSceneToSequence(const std::filesystem::path& scene_file,
+                                       const std::filesystem::path& out_dir,
+                                       const SimulateConfig& config,
+                                       const SimulateProgress& progress) {
+    return SimulateSceneToSequence(LoadSceneSpec(scene_file), out_dir, config, progress);
+}
+
+}  // namespace strata::sim
