@@ -1,0 +1,58 @@
+#include "io/TextParsing.hpp"
+
+#include <charconv>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace strata::io::detail {
+
+std::string ReadTextFile(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        throw std::runtime_error(path.string() + ": is a directory, expected a file");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path.string() + ": cannot open file for reading");
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    if (in.bad()) throw std::runtime_error(path.string() + ": read error");
+    return buffer.str();
+}
+
+bool ParseDouble(std::string_view token, double& value) {
+    // from_chars rejects a leading '+', which some writers emit.
+    if (token.size() > 1 && token.front() == '+') token.remove_prefix(1);
+    if (token.empty()) return false;
+    const char* end = token.data() + token.size();
+    const auto result = std::from_chars(token.data(), end, value);
+    return result.ec == std::errc() && result.ptr == end;
+}
+
+bool ParseUint(std::string_view token, unsigned long long& value) {
+    if (token.empty()) return false;
+    const char* end = token.data() + token.size();
+    const auto result = std::from_chars(token.data(), end, value);
+    return result.ec == std::errc() && result.ptr == end;
+}
+
+std::string_view StripComment(std::string_view line) {
+    const size_t hash = line.find('#');
+    return hash == std::string_view::npos ? line : line.substr(0, hash);
+}
+
+void SplitFields(std::string_view line, std::vector<std::string_view>& fields) {
+    fields.clear();
+    constexpr std::string_view kSeparators = " \t\r,";
+    size_t pos = line.find_first_not_of(kSeparators);
+    while (pos != std::string_view::npos) {
+        const size_t end = line.find_first_of(kSeparators, pos);
+        const size_t stop = end == std::string_view::npos ? line.size() : end;
+        fields.push_back(line.substr(pos, stop - pos));
+        pos = stop == line.size() ? std::string_view::npos
+                                  : line.find_first_not_of(kSeparators, stop);
+    }
+}
+
+}  // namespace strata::io::detail
