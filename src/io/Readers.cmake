@@ -1,3 +1,5 @@
 # Scan readers and pose files (owned by the readers; included by src/io/CMakeLists.txt).
 list(APPEND STRATA_IO_SOURCES
-  TextParsing.cpp PoseFiles.cpp MatchPoses.cpp)
+  BinaryCursor.cpp TextParsing.cpp ScanBuilder.cpp
+  PcdHeader.cpp PcdReader.cpp PlyHeader.cpp PlyReader.cpp LasReader.cpp TextReader.cpp
+  ReadPointCloud.cpp PoseFiles.cpp MatchPoses.cpp)

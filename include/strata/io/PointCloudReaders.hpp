@@ -1,0 +1,75 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+
+#include "strata/core/Labels.hpp"
+#include "strata/core/Scan.hpp"
+
+namespace strata::io {
+
+/// @brief How a point cloud file is turned into a Scan.
+struct ReadOptions {
+    /// Subtracted from every coordinate in double precision (georeferenced data, e.g. LAS in UTM).
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    /// nullptr: the format's default (SemanticKITTI ids for PCD/PLY/text, LAS classes for LAS).
+    const core::LabelMapping* mapping = nullptr;
+};
+
+/// @brief Reads a point cloud chosen by extension: .pcd, .ply, .las, text (.txt .xyz .csv .dat)
+/// and bzip2-compressed text (any name ending in .bz2).
+/// @return a Scan at the identity pose, `time_s` 0 and `source` = path. Points are in the file's
+/// frame minus `options.origin`. Non-finite points are dropped (PCD also drops (0,0,0), which
+/// organised clouds use for missing returns).
+/// @note Raw label ids follow SemanticKITTI's packing: the low 16 bits are the class (mapped to
+/// `labels`), the high 16 bits the instance (`instances` is filled only when one is non-zero).
+/// @throws std::invalid_argument for an unknown extension; std::runtime_error naming the file for
+/// .laz (with a hint to decompress it) and any unreadable, truncated or inconsistent file.
+[[nodiscard]] core::Scan ReadPointCloud(const std::filesystem::path& path,
+                                        const ReadOptions& options = {});
+
+/// @brief PCD v0.7 with DATA ascii, binary or binary_compressed (LZF), any field order and types.
+/// Uses x y z, optional `intensity` and optional `label`; other fields are skipped.
+[[nodiscard]] core::Scan ReadPcd(const std::filesystem::path& path,
+                                 const ReadOptions& options = {});
+
+/// @brief PLY (ascii, binary_little_endian, binary_big_endian). Uses the `vertex` element's x y z,
+/// optional label (`label`, `class`, `classification`) and intensity (`intensity`,
+/// `scalar_intensity`, `reflectance`); other elements and properties, lists included, are skipped.
+[[nodiscard]] core::Scan ReadPly(const std::filesystem::path& path,
+                                 const ReadOptions& options = {});
+
+/// @brief Uncompressed LAS 1.0-1.4, point formats 0-10. Labels are the classification codes
+/// (formats 0-5: the low 5 bits), intensity the 16-bit intensity.
+[[nodiscard]] core::Scan ReadLas(const std::filesystem::path& path,
+                                 const ReadOptions& options = {});
+
+/// @brief Text with `x y z [label]` per line, separated by whitespace or commas; `#` starts a
+/// comment. Files ending in .bz2 are decompressed with libbz2. Every line must have the same
+/// number of values (3 or 4); a bad line is reported with its line number.
+[[nodiscard]] core::Scan ReadText(const std::filesystem::path& path,
+                                  const ReadOptions& options = {});
+
+/// @brief The fields of a LAS public header block that readers need.
+struct LasHeader {
+    uint8_t version_major = 0;
+    uint8_t version_minor = 0;
+    uint8_t point_format = 0;        ///< without the compression bits
+    bool compressed = false;         ///< LAZ: point format had bit 7 (or 6) set
+    uint16_t header_size = 0;        ///< bytes
+    uint32_t point_data_offset = 0;  ///< bytes from the start of the file
+    uint16_t point_record_length = 0;
+    uint64_t point_count = 0;  ///< the 64-bit count of LAS 1.4 when it is set
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+    Eigen::Vector3d min = Eigen::Vector3d::Zero();  ///< as the header states it, file units
+    Eigen::Vector3d max = Eigen::Vector3d::Zero();
+};
+
+/// @brief Reads and checks a LAS header (signature, sizes, point format) without reading points.
+/// @throws std::runtime_error naming the file when the header is invalid or disagrees with the
+/// file size. A compressed (LAZ) header is returned with `compressed` set, not refused.
+[[nodiscard]] LasHeader ReadLasHeader(const std::filesystem::path& path);
+
+}  // namespace strata::io

@@ -1,0 +1,97 @@
+#include "io/BinaryCursor.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace strata::io::detail {
+
+std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path, size_t max_bytes,
+                                   size_t* file_size) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        throw std::runtime_error(path.string() + ": is a directory, expected a file");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path.string() + ": cannot open file for reading");
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (size < 0) throw std::runtime_error(path.string() + ": cannot determine the file size");
+    in.seekg(0, std::ios::beg);
+    if (file_size != nullptr) *file_size = static_cast<size_t>(size);
+    const size_t wanted = std::min(static_cast<size_t>(size), max_bytes);
+    std::vector<uint8_t> bytes(wanted);
+    if (wanted > 0 &&
+        !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(wanted))) {
+        throw std::runtime_error(path.string() + ": read error after " +
+                                 std::to_string(in.gcount()) + " of " + std::to_string(wanted) +
+                                 " bytes");
+    }
+    return bytes;
+}
+
+size_t ScalarSize(ScalarType type) {
+    switch (type) {
+        case ScalarType::kI8:
+        case ScalarType::kU8:
+            return 1;
+        case ScalarType::kI16:
+        case ScalarType::kU16:
+            return 2;
+        case ScalarType::kI32:
+        case ScalarType::kU32:
+        case ScalarType::kF32:
+            return 4;
+        case ScalarType::kI64:
+        case ScalarType::kU64:
+        case ScalarType::kF64:
+            return 8;
+    }
+    return 0;
+}
+
+double LoadAsDouble(const uint8_t* p, ScalarType type, bool big_endian) {
+    switch (type) {
+        case ScalarType::kI8:
+            return LoadScalar<int8_t>(p, big_endian);
+        case ScalarType::kU8:
+            return LoadScalar<uint8_t>(p, big_endian);
+        case ScalarType::kI16:
+            return LoadScalar<int16_t>(p, big_endian);
+        case ScalarType::kU16:
+            return LoadScalar<uint16_t>(p, big_endian);
+        case ScalarType::kI32:
+            return LoadScalar<int32_t>(p, big_endian);
+        case ScalarType::kU32:
+            return LoadScalar<uint32_t>(p, big_endian);
+        case ScalarType::kI64:
+            return static_cast<double>(LoadScalar<int64_t>(p, big_endian));
+        case ScalarType::kU64:
+            return static_cast<double>(LoadScalar<uint64_t>(p, big_endian));
+        case ScalarType::kF32:
+            return LoadScalar<float>(p, big_endian);
+        case ScalarType::kF64:
+            return LoadScalar<double>(p, big_endian);
+    }
+    return 0.0;
+}
+
+void BinaryCursor::Seek(size_t pos, const char* what) {
+    if (pos > size_) {
+        Fail(std::string(what) + " at byte " + std::to_string(pos) + " lies past the end of the " +
+             std::to_string(size_) + "-byte file");
+    }
+    pos_ = pos;
+}
+
+void BinaryCursor::Fail(const std::string& message) const {
+    throw std::runtime_error(file_ + ": " + message);
+}
+
+void BinaryCursor::FailTruncated(size_t n, const char* what) const {
+    Fail("truncated: " + std::string(what) + " needs " + std::to_string(n) + " bytes at byte " +
+         std::to_string(pos_) + ", but only " + std::to_string(remaining()) + " remain");
+}
+
+}  // namespace strata::io::detail
