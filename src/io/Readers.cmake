@@ -2,4 +2,4 @@
 list(APPEND STRATA_IO_SOURCES
   BinaryCursor.cpp TextParsing.cpp ScanBuilder.cpp
   PcdHeader.cpp PcdReader.cpp PlyHeader.cpp PlyReader.cpp LasReader.cpp TextReader.cpp
-  ReadPointCloud.cpp PoseFiles.cpp MatchPoses.cpp)
+  ReadPointCloud.cpp KittiFiles.cpp KittiSequence.cpp PoseFiles.cpp MatchPoses.cpp)
