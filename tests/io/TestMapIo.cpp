@@ -56,7 +56,9 @@ TEST(MapIo, FailedSaveLeavesPreviousMapIntact) {
     MapDirectory other{core::VoxelMap::Create(0.5), {}};
     fs::permissions(dir, fs::perms::owner_read | fs::perms::owner_exec);
     const bool can_block = ::geteuid() != 0;  // root ignores permissions
-    if (can_block) EXPECT_THROW(SaveMapDirectory(other, dir), std::runtime_error);
+    if (can_block) {
+        EXPECT_THROW(SaveMapDirectory(other, dir), std::runtime_error);
+    }
     fs::permissions(dir, fs::perms::owner_all);
     EXPECT_FLOAT_EQ(LoadMapDirectory(dir).map.occupancy->tree().getValue({1, 1, 1}), 2.0f);
     fs::remove_all(dir);

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Runs the benchmarks and rewrites docs/bench.md with the date, commit and CPU.
+# Usage: bench/run_benchmarks.sh [BUILD_DIR]   (default build/; needs ../shared/data)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build}
+out=$root/docs/bench.md
+cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
+{
+  echo "# Benchmarks"
+  echo
+  echo "Measured $(date -u +%Y-%m-%d) on commit \`$(git -C "$root" rev-parse --short HEAD)\`,"
+  echo "CPU: $cpu, $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB RAM (a shared virtual machine: expect"
+  echo "run-to-run noise of 10-20 %). Regenerate with \`bench/run_benchmarks.sh\`."
+  echo
+  echo "## Integration: strata vs OctoMap 1.9.7 (\`bench/bench_integration\`)"
+  echo
+  echo "Same float points, same process, max range 50 m. OctoMap: \`OcTree::insertPointCloud\`"
+  echo "(compiled without OpenMP, i.e. one thread). strata: \`Integrator::Integrate\` with TBB limited"
+  echo "to 1 and 2 threads. Memory: \`OcTree::memoryUsage()\` vs the sum of \`memUsage()\` of our four"
+  echo "grids (occupancy, label, label_weight, hits). Jaccard: occupied and free voxel sets, OctoMap's"
+  echo "pruned nodes expanded to voxels."
+  echo
+  "$build/bench/bench_integration" "$root/../shared/data"
+  if [[ -x "$build/bench/bench_sim" ]]; then
+    echo
+    echo "## Simulator (\`bench/bench_sim\`)"
+    echo
+    echo '```'
+    "$build/bench/bench_sim" --benchmark_min_time=1 2>/dev/null | grep -v '^\*\*\*'
+    echo '```'
+  fi
+} > "$out.tmp"
+mv "$out.tmp" "$out"
+echo "wrote $out"

@@ -1,0 +1,38 @@
+#include "Progress.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace strata::tools {
+
+Progress::Progress(std::string label, size_t total)
+    : label_(std::move(label)), total_(total), enabled_(::isatty(STDERR_FILENO) == 1) {}
+
+Progress::~Progress() {
+    if (enabled_) std::fputc('\n', stderr);
+}
+
+void Progress::Advance(size_t n) {
+    done_ += n;
+    if (enabled_) Draw();
+}
+
+void Progress::Update(size_t done, size_t total) {
+    done_ = done;
+    total_ = total;
+    if (enabled_) Draw();
+}
+
+void Progress::Draw() const {
+    constexpr int kWidth = 30;
+    const double fraction = total_ ? static_cast<double>(done_) / static_cast<double>(total_) : 1.0;
+    const int filled = static_cast<int>(fraction * kWidth);
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu %.1fs", label_.c_str(), filled,
+                 "##############################", kWidth - filled, "", done_, total_, elapsed);
+    std::fflush(stderr);
+}
+
+}  // namespace strata::tools

@@ -1,0 +1,94 @@
+#include "ScanSource.hpp"
+
+#include <stdexcept>
+
+#include "MapAccess.hpp"
+#include "Progress.hpp"
+#include "strata/integration/Integrator.hpp"
+#include "strata/io/PoseFiles.hpp"
+
+namespace strata::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// "A:B", "A:", ":B" or "A" (one frame). Half-open, checked against the sequence length.
+std::pair<size_t, size_t> ParseFrames(const std::string& text, size_t n) {
+    if (text.empty()) return {0, n};
+    try {
+        const auto colon = text.find(':');
+        if (colon == std::string::npos) {
+            const size_t a = std::stoul(text);
+            return {a, a + 1};
+        }
+        const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+        const size_t begin = a.empty() ? 0 : std::stoul(a);
+        const size_t end = b.empty() ? n : std::stoul(b);
+        if (begin < end && end <= n) return {begin, end};
+    } catch (const std::logic_error&) {
+    }
+    throw std::invalid_argument("--frames '" + text + "': expected A:B with 0 <= A < B <= " +
+                                std::to_string(n));
+}
+
+}  // namespace
+
+ScanSource ScanSource::Kitti(const fs::path& dir, const std::string& frames) {
+    ScanSource s;
+    s.kitti_ = io::OpenKittiSequence(dir);
+    const auto [begin, end] = ParseFrames(frames, s.kitti_->size());
+    for (size_t i = begin; i < end; ++i) s.indices_.push_back(i);
+    return s;
+}
+
+ScanSource ScanSource::Files(std::vector<fs::path> files, const fs::path& poses,
+                             const io::ReadOptions& options) {
+    ScanSource s;
+    s.files_ = std::move(files);
+    s.options_ = options;
+    for (size_t i = 0; i < s.files_.size(); ++i) s.indices_.push_back(i);
+    if (!poses.empty()) {
+        const auto stamped = io::ReadPoseFile(poses);
+        if (stamped.size() < s.files_.size()) {
+            throw std::runtime_error(poses.string() + ": " + std::to_string(stamped.size()) +
+                                     " poses for " + std::to_string(s.files_.size()) + " scans");
+        }
+        for (size_t i = 0; i < s.files_.size(); ++i) s.poses_.push_back(stamped[i].T);
+    }
+    return s;
+}
+
+core::Scan ScanSource::Read(size_t i) const {
+    if (kitti_) return io::ReadKittiScan(*kitti_, indices_.at(i));
+    core::Scan scan = io::ReadPointCloud(files_.at(i), options_);
+    if (!poses_.empty()) scan.T_world_sensor = poses_[i];
+    return scan;
+}
+
+std::string ScanSource::Describe() const {
+    if (kitti_) return kitti_->dir.string();
+    return files_.empty() ? std::string() : files_.front().string();
+}
+
+io::MapSession IntegrateSession(io::MapDirectory& map, const ScanSource& source,
+                                const integration::IntegrationConfig& config,
+                                const std::string& name) {
+    integration::Integrator integrator(map.map, config);
+    io::MapSession session;
+    session.id = map.sessions.empty() ? 1 : map.sessions.back().id + 1;
+    session.name = name.empty() ? "session_" + std::to_string(session.id) : name;
+    session.source = source.Describe();
+    session.created_utc = UtcNow();
+    Progress progress("integrating", source.size());
+    for (size_t i = 0; i < source.size(); ++i) {
+        const auto update = integrator.Integrate(source.Read(i));
+        session.points += update.points - update.dropped;
+        ++session.scans;
+        progress.Advance();
+    }
+    map.sessions.push_back(session);
+    return session;
+}
+
+}  // namespace strata::tools
