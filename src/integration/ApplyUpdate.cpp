@@ -8,21 +8,18 @@ namespace strata::integration::detail {
 namespace {
 
 // Adds `delta` to every voxel of `mask` (an unobserved voxel starts at log-odds 0), clamped to
-// [lo, hi]: OctoMap's updateNodeLogOdds. Leaves are created first (serially, topology changes are
-// not thread-safe), then values are updated in parallel, one mask leaf per task.
+// [lo, hi]: OctoMap's updateNodeLogOdds. The mask's voxels are first activated in the tree
+// (topologyUnion, parallel; newly observed voxels take the background, 0, and active tiles under
+// the mask become leaves), then values are updated in parallel, one mask leaf per task.
 void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float delta, float lo,
                 float hi) {
-    {
-        openvdb::tree::ValueAccessor<openvdb::FloatTree> acc(tree);
-        for (auto it = mask.cbeginLeaf(); it; ++it) acc.touchLeaf(it->origin());
-    }
+    tree.topologyUnion(mask);
     openvdb::tree::LeafManager<const openvdb::MaskTree> leaves(mask);
     leaves.foreach([&](const openvdb::MaskTree::LeafNodeType& mask_leaf, size_t) {
-        auto* leaf = tree.probeLeaf(mask_leaf.origin());
+        float* values = tree.probeLeaf(mask_leaf.origin())->buffer().data();
         for (auto on = mask_leaf.getValueMask().beginOn(); on; ++on) {
-            const openvdb::Index n = on.pos();
-            const float old = leaf->isValueOn(n) ? leaf->getValue(n) : 0.0f;
-            leaf->setValueOn(n, std::clamp(old + delta, lo, hi));
+            float& v = values[on.pos()];
+            v = std::clamp(v + delta, lo, hi);
         }
     });
 }

@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 
@@ -65,12 +66,13 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
 
     const detail::PreparedScan prepared =
         detail::PrepareScan(points_map, T_map_sensor.translation(), map.voxel_size, config);
-    detail::ScanMasks masks = detail::MarkScan(prepared, config);
-
+    // Grouping endpoints (serial) runs beside the parallel ray marking.
     ScanUpdate update;
+    detail::ScanMasks masks;
+    tbb::parallel_invoke([&] { masks = detail::MarkScan(prepared, config); },
+                         [&] { update.endpoints = GroupEndpoints(prepared, scan); });
     update.free = masks.free;
     update.occupied = masks.occupied;
-    update.endpoints = GroupEndpoints(prepared, scan);
     update.points = scan.points.size();
     update.dropped = prepared.dropped;
     update.clipped = prepared.clipped;
@@ -80,8 +82,9 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
 void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
                      const IntegrationConfig& config) {
     config.Validate();
-    detail::ApplyOccupancy(update, *map.occupancy, config);
-    detail::ApplyEndpoints(update, map, config);
+    // Different grids: the two run side by side.
+    tbb::parallel_invoke([&] { detail::ApplyOccupancy(update, *map.occupancy, config); },
+                         [&] { detail::ApplyEndpoints(update, map, config); });
 }
 
 Integrator::Integrator(core::VoxelMap& map, const IntegrationConfig& config)

@@ -107,10 +107,11 @@ ScanMasks MarkDense(const PreparedScan& scan) {
     // Bricks to leaves, parallel over x-slabs of bricks; free minus occupied (occupied wins).
     std::vector<const uint8_t*> locals;
     for (const Bitmap& b : free_bits) locals.push_back(b.bytes.get());
-    tbb::enumerable_thread_specific<std::vector<std::unique_ptr<MaskLeaf>>> free_leaves, occ_leaves;
+    // Each thread fills its own trees; merging them afterwards only moves nodes.
+    tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees, occ_trees;
     tbb::parallel_for(tbb::blocked_range<int64_t>(0, box.nx / 8), [&](const auto& range) {
-        auto& my_free = free_leaves.local();
-        auto& my_occ = occ_leaves.local();
+        openvdb::MaskTree& my_free = free_trees.local();
+        openvdb::MaskTree& my_occ = occ_trees.local();
         uint64_t occ[8], fre[8], tmp[8];
         for (int64_t bx = range.begin() * 8; bx != range.end() * 8; bx += 8) {
             for (int64_t by = 0; by < box.ny; by += 8) {
@@ -130,12 +131,12 @@ ScanMasks MarkDense(const PreparedScan& scan) {
                     const openvdb::Coord origin =
                         box.lo + openvdb::Coord(static_cast<int32_t>(bx), static_cast<int32_t>(by),
                                                 static_cast<int32_t>(bz));
-                    const auto emit = [&origin](const uint64_t* words, auto& out) {
-                        auto leaf = std::make_unique<MaskLeaf>(origin);
+                    const auto emit = [&origin](const uint64_t* words, openvdb::MaskTree& out) {
+                        auto* leaf = new MaskLeaf(origin);
                         for (int w = 0; w < 8; ++w) {
                             leaf->getValueMask().template getWord<uint64_t>(w) = words[w];
                         }
-                        out.push_back(std::move(leaf));
+                        out.addLeaf(leaf);  // the tree owns it
                     };
                     if (any_free) emit(fre, my_free);
                     if (any_occ) emit(occ, my_occ);
@@ -144,12 +145,8 @@ ScanMasks MarkDense(const PreparedScan& scan) {
         }
     });
     ScanMasks masks;
-    for (auto& leaves : free_leaves) {
-        for (auto& leaf : leaves) masks.free->addLeaf(leaf.release());
-    }
-    for (auto& leaves : occ_leaves) {
-        for (auto& leaf : leaves) masks.occupied->addLeaf(leaf.release());
-    }
+    for (auto& tree : free_trees) masks.free->merge(tree, openvdb::MERGE_NODES);
+    for (auto& tree : occ_trees) masks.occupied->merge(tree, openvdb::MERGE_NODES);
     return masks;
 }
 

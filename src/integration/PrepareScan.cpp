@@ -133,7 +133,13 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
         });
     scan.box = MakeBox(bbox);
 
-    // Pass 2: endpoint voxels, in scan order.
+    // Pass 2: endpoint voxels (parallel), then kept in scan order (serial, a copy).
+    std::vector<int64_t> pos(n);
+    tbb::parallel_for(Range(0, n, kPointGrain), [&](const Range& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            if (scan.kinds[i] == PointKind::kHit) pos[i] = scan.box.Index(Key(scan.ends[i], inv_voxel));
+        }
+    });
     scan.endpoint_pos.reserve(n);
     scan.endpoint_point.reserve(n);
     for (size_t i = 0; i < n; ++i) {
@@ -145,7 +151,7 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                 ++scan.clipped;
                 break;
             case PointKind::kHit:
-                scan.endpoint_pos.push_back(scan.box.Index(Key(scan.ends[i], inv_voxel)));
+                scan.endpoint_pos.push_back(pos[i]);
                 scan.endpoint_point.push_back(static_cast<uint32_t>(i));
                 break;
         }
