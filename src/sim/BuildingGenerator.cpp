@@ -38,7 +38,8 @@ public:
             w.part_ids.push_back(i == 0 ? 0 : a_.NewId());
         }
         w.z_base = Z(k);
-        w.height_m = c_.floor_height - c_.slab_thickness;
+        // Up to 1 cm under the slab above: coincident faces would make inside tests ambiguous.
+        w.height_m = c_.floor_height - c_.slab_thickness - 0.01;
         w.thickness_m = thickness;
         w.slant_deg = slant_deg;
         w.openings = std::move(openings);

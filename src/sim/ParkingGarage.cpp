@@ -156,10 +156,10 @@ void GenerateParkingGarage(JsonReader& r, SceneAssembler& a) {
                 ObjectSpec pillar;
                 pillar.label = kitti::kOtherStructure;
                 const double py = back + (faces_north ? 0.5 : -0.5) * c.pillar_size;
-                pillar.shape = BoxSpec{{x, py, z + 0.5 * c.ceiling_height},
-                                       {c.pillar_size, c.pillar_size, c.ceiling_height},
-                                       0.0,
-                                       false};
+                // 1 cm short of the ceiling, so that no two faces coincide.
+                const double height = c.ceiling_height - 0.01;
+                pillar.shape = BoxSpec{
+                    {x, py, z + 0.5 * height}, {c.pillar_size, c.pillar_size, height}, 0.0, false};
                 a.Add(std::move(pillar), "pillar");
             }
         }

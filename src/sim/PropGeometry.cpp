@@ -57,7 +57,7 @@ std::vector<Mesh> BuildPropMeshes(const ObjectSpec& object) {
 }
 
 std::vector<Mesh> BuildObjectMeshes(const ObjectSpec& object, uint64_t scene_seed) {
-    return std::visit(
+    std::vector<Mesh> meshes = std::visit(
         [&](const auto& shape) -> std::vector<Mesh> {
             using T = std::decay_t<decltype(shape)>;
             if constexpr (std::is_same_v<T, SlabSpec>) {
@@ -73,6 +73,10 @@ std::vector<Mesh> BuildObjectMeshes(const ObjectSpec& object, uint64_t scene_see
             }
         },
         object.shape);
+    const bool solid = !std::holds_alternative<SlabSpec>(object.shape) &&
+                       !std::holds_alternative<PlantSpec>(object.shape);
+    for (Mesh& m : meshes) m.solid = solid;
+    return meshes;
 }
 
 BoxTruth ObjectBox(const ObjectSpec& object) {

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 
 #include "strata/sim/KittiIds.hpp"
@@ -54,6 +55,24 @@ private:
     double pixel_m_;
 };
 
+// The solid enclosing a point: looking up from inside a wall, box or pole one crosses the
+// faces of that object an odd number of times (its bottom may be open, its top is closed).
+// Counting one object only keeps faces of other objects that touch it out of the count.
+std::optional<RayHit> SolidAround(const Scene& scene, const Simulator& simulator,
+                                  const Eigen::Vector3d& point) {
+    const auto first = simulator.CastRay(point, Eigen::Vector3d::UnitZ(), 1e3);
+    if (!first || !scene.meshes[first->mesh].solid) return std::nullopt;
+    int crossings = 0;
+    Eigen::Vector3d o = point;
+    for (int step = 0; step < 64; ++step) {
+        const auto hit = simulator.CastRay(o, Eigen::Vector3d::UnitZ(), 1e3);
+        if (!hit) break;
+        crossings += hit->instance == first->instance ? 1 : 0;
+        o = hit->point + Eigen::Vector3d(0, 0, 1e-4);
+    }
+    return crossings % 2 == 1 ? first : std::nullopt;
+}
+
 }  // namespace
 
 void PictureConfig::Validate() const {
@@ -73,7 +92,8 @@ Picture RenderScenePicture(const Scene& scene, const Simulator& simulator,
     p.width = std::max(1, static_cast<int>(std::ceil(extent.x() / pixel_m)));
     p.height = std::max(1, static_cast<int>(std::ceil(extent.y() / pixel_m)));
     p.rgb.assign(size_t(p.width) * size_t(p.height) * 3, 24);
-    const double z_top = std::isnan(config.cut_z) ? scene.bounds.max().z() + 1.0 : config.cut_z;
+    const bool cut = !std::isnan(config.cut_z);
+    const double z_top = cut ? config.cut_z : scene.bounds.max().z() + 1.0;
     const double z_span = std::max(1.0, z_top - scene.bounds.min().z());
     // Range: picture rows; one downward ray per pixel.
     tbb::parallel_for(tbb::blocked_range<int>(0, p.height), [&](const tbb::blocked_range<int>& r) {
@@ -81,12 +101,17 @@ Picture RenderScenePicture(const Scene& scene, const Simulator& simulator,
             for (int x = 0; x < p.width; ++x) {
                 const Eigen::Vector3d origin(min_xy.x() + (x + 0.5) * pixel_m,
                                              min_xy.y() + (p.height - y - 0.5) * pixel_m, z_top);
-                const auto hit = simulator.CastRay(origin, -Eigen::Vector3d::UnitZ(), 1e4);
+                // Cut inside a solid (a wall spanning the cut height): draw the solid, darker.
+                const std::optional<RayHit> solid =
+                    cut ? SolidAround(scene, simulator, origin) : std::nullopt;
+                const auto hit =
+                    solid ? solid : simulator.CastRay(origin, -Eigen::Vector3d::UnitZ(), 1e4);
                 if (!hit) continue;
                 // Class colour, darker on steep faces and lower down.
                 const core::Rgb c = kitti::Color(hit->label);
-                const double shade = (0.55 + 0.45 * std::abs(hit->normal.z())) *
-                                     (0.75 + 0.25 * (1.0 - hit->range_m / z_span));
+                const double shade = solid ? 0.6
+                                           : (0.55 + 0.45 * std::abs(hit->normal.z())) *
+                                                 (0.75 + 0.25 * (1.0 - hit->range_m / z_span));
                 uint8_t* px = &p.rgb[(size_t(y) * size_t(p.width) + size_t(x)) * 3];
                 px[0] = static_cast<uint8_t>(std::clamp(c.r * shade, 0.0, 255.0));
                 px[1] = static_cast<uint8_t>(std::clamp(c.g * shade, 0.0, 255.0));

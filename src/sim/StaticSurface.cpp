@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -11,6 +12,13 @@
 #include "strata/sim/Simulator.hpp"
 
 namespace strata::sim {
+namespace {
+
+// A point hidden from its nearest scan positions is taken as unobserved (bounds the cost where
+// most of the surface is hidden, as indoors).
+constexpr size_t kOriginsTried = 8;
+
+}  // namespace
 
 SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m, uint64_t seed) {
     if (!(spacing_m > 0.0)) throw std::invalid_argument("surface spacing must be positive");
@@ -44,22 +52,31 @@ SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m, uint64_t
 void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
                   const std::vector<Eigen::Vector3d>& origins_world, double max_range_m) {
     sample.observed.assign(sample.points.size(), 0);
-    // Range: points; each point stops at the first origin that sees it.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, sample.points.size(), 1024),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i != r.end(); ++i) {
-                              for (const Eigen::Vector3d& o : origins_world) {
-                                  const Eigen::Vector3d d = sample.points[i] - o;
-                                  const double dist = d.norm();
-                                  if (dist > max_range_m || dist < 1e-6) continue;
-                                  // Stop just short of the point: it lies on its own surface.
-                                  if (!simulator.CastRay(o, d, dist - 0.02)) {
-                                      sample.observed[i] = 1;
-                                      break;
-                                  }
-                              }
-                          }
-                      });
+    // Range: points; each point tries its nearest origins and stops at the first that sees it.
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, sample.points.size(), 1024),
+        [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<std::pair<double, size_t>> by_distance(origins_world.size());
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                for (size_t k = 0; k < origins_world.size(); ++k) {
+                    by_distance[k] = {(sample.points[i] - origins_world[k]).squaredNorm(), k};
+                }
+                const size_t tries = std::min(kOriginsTried, by_distance.size());
+                std::partial_sort(by_distance.begin(), by_distance.begin() + tries,
+                                  by_distance.end());
+                for (size_t k = 0; k < tries; ++k) {
+                    const Eigen::Vector3d& o = origins_world[by_distance[k].second];
+                    const Eigen::Vector3d d = sample.points[i] - o;
+                    const double dist = d.norm();
+                    if (dist > max_range_m || dist < 1e-6) break;
+                    // Stop just short of the point: it lies on its own surface.
+                    if (!simulator.CastRay(o, d, dist - 0.02)) {
+                        sample.observed[i] = 1;
+                        break;
+                    }
+                }
+            }
+        });
 }
 
 void WriteSurfacePly(const std::filesystem::path& path, const SurfaceSample& sample,

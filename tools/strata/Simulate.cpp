@@ -30,8 +30,8 @@ struct SimulateArgs {
 void Run(SimulateArgs& args, const CLI::App& cmd) {
     std::unique_ptr<tbb::global_control> limit;
     if (args.threads > 0) {
-        limit = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism, args.threads);
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      args.threads);
     }
     const sim::SceneSpec scene = sim::LoadSceneSpec(args.scene);
     sim::SimulateConfig& config = args.config;
@@ -47,10 +47,10 @@ void Run(SimulateArgs& args, const CLI::App& cmd) {
         {"seed", config.seed.value_or(scene.seed)},
         {"max_scans", config.max_scans},
         {"motion", config.motion},
-        {"range_noise_m", config.range_noise_m.value_or(
-                              sim::SensorModel::FromName(config.sensor.empty() ? scene.sensor
-                                                                               : config.sensor)
-                                  .range_noise_m)},
+        {"range_noise_m",
+         config.range_noise_m.value_or(
+             sim::SensorModel::FromName(config.sensor.empty() ? scene.sensor : config.sensor)
+                 .range_noise_m)},
         {"surface_spacing_m", config.surface_spacing_m},
         {"sessions", scene.sessions.size()}};
     std::cerr << "strata simulate: " << effective.dump() << "\n";
@@ -64,14 +64,21 @@ void Run(SimulateArgs& args, const CLI::App& cmd) {
     nlohmann::json sessions = nlohmann::json::array();
     for (const sim::SessionReport& s : report.sessions) {
         const double rate = s.trace_seconds > 0 ? s.rays / s.trace_seconds : 0.0;
-        sessions.push_back({{"name", s.name}, {"dir", s.dir.string()}, {"scans", s.scans},
-                            {"points", s.points}, {"rays", s.rays}, {"triangles", s.triangles},
-                            {"walls", s.walls}, {"vehicles", s.vehicles}, {"edits", s.edits},
-                            {"surface_points", s.surface_points}, {"rays_per_s", rate}});
+        sessions.push_back({{"name", s.name},
+                            {"dir", s.dir.string()},
+                            {"scans", s.scans},
+                            {"points", s.points},
+                            {"rays", s.rays},
+                            {"triangles", s.triangles},
+                            {"walls", s.walls},
+                            {"vehicles", s.vehicles},
+                            {"edits", s.edits},
+                            {"surface_points", s.surface_points},
+                            {"rays_per_s", rate}});
         if (!args.json) {
-            std::cout << s.dir.string() << ": " << s.scans << " scans, " << s.points
-                      << " points, " << s.walls << " walls, " << s.vehicles << " vehicles, "
-                      << s.edits << " edits, " << s.surface_points << " surface points; "
+            std::cout << s.dir.string() << ": " << s.scans << " scans, " << s.points << " points, "
+                      << s.walls << " walls, " << s.vehicles << " vehicles, " << s.edits
+                      << " edits, " << s.surface_points << " surface points; "
                       << static_cast<long>(rate) << " rays/s\n";
         }
     }
@@ -93,9 +100,12 @@ void RegisterSimulate(CLI::App& app) {
         "  strata simulate --scene datasets/scenes/street_two_sessions.json --out out/s2 \\\n"
         "      --sensor os1-64 --seed 7 --max-scans 10\n"
         "  strata integrate street.strata --kitti out/street");
-    cmd->add_option("--scene", args->scene, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("--scene", args->scene, "Scene file (JSON)")
+        ->required()
+        ->check(CLI::ExistingFile);
     cmd->add_option("--out", args->out, "Output sequence folder")->required();
-    cmd->add_option("--sensor", args->sensor, "hdl64, vlp16, os1-64 or os1-128 (default: the scene's)");
+    cmd->add_option("--sensor", args->sensor,
+                    "hdl64, vlp16, os1-64 or os1-128 (default: the scene's)");
     cmd->add_option("--seed", args->seed, "Noise seed (default: the scene's seed)");
     cmd->add_option("--max-scans", args->config.max_scans, "Cap on scans per session (0 = scene's)")
         ->capture_default_str();
@@ -110,7 +120,8 @@ void RegisterSimulate(CLI::App& app) {
     cmd->add_option("--picture-pixel", args->config.picture.pixel_m,
                     "Ground size of a picture.png pixel (m)")
         ->capture_default_str();
-    cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->capture_default_str();
+    cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")
+        ->capture_default_str();
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->callback([args, cmd] { Run(*args, *cmd); });
 }

@@ -18,6 +18,9 @@ struct Mesh {
     uint16_t instance = 0;  ///< object id
     float reflectivity = 0.3F;
     bool is_static = true;  ///< part of the ground-truth static surface (vehicles are not)
+    /// Faces of a solid (wall, box, pole, vehicle) closed everywhere but possibly at its
+    /// bottom: a point right under one of its horizontal faces is inside it.
+    bool solid = false;
 
     /// @brief Appends another mesh's triangles (same class assumed).
     void Append(const Mesh& other);

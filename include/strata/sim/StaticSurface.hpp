@@ -25,8 +25,8 @@ struct SurfaceSample {
 [[nodiscard]] SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m,
                                                 uint64_t seed);
 
-/// @brief Sets `observed` for points with a free line of sight from at least one origin within
-/// max_range_m (the sensor's field of view is not modelled). Parallel (TBB).
+/// @brief Sets `observed` for points with a free line of sight from one of their 8 nearest
+/// origins within max_range_m (the sensor's field of view is not modelled). Parallel (TBB).
 void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
                   const std::vector<Eigen::Vector3d>& origins_world, double max_range_m);
 
