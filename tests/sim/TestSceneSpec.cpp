@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "SimTestUtil.hpp"
@@ -125,6 +127,25 @@ TEST(SceneSpec, BuildingHasStoreysInTheirOwnFrames) {
     for (size_t k = 1; k < spec.sessions.size(); ++k) {
         EXPECT_FALSE(spec.sessions[k].T_world_session.isApprox(spec.sessions[0].T_world_session));
     }
+}
+
+}  // namespace strata::sim
+
+namespace strata::sim {
+
+// The example in docs/simulator.md stays a valid scene.
+TEST(SceneSpec, DocumentationExampleParses) {
+    std::ifstream doc(std::string(STRATA_SOURCE_DIR) + "/docs/simulator.md");
+    ASSERT_TRUE(doc.good());
+    std::stringstream text;
+    text << doc.rdbuf();
+    const std::string md = text.str();
+    const size_t begin = md.find("```json\n");
+    ASSERT_NE(begin, std::string::npos);
+    const size_t end = md.find("```", begin + 8);
+    const SceneSpec spec = ParseSceneSpec(md.substr(begin + 8, end - begin - 8), "simulator.md");
+    EXPECT_EQ(spec.sessions.size(), 2U);
+    EXPECT_EQ(ObjectsOfSession(spec, 1).size() + 1, spec.objects.size());
 }
 
 }  // namespace strata::sim
