@@ -35,11 +35,20 @@ void ApplyOccupancy(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
 }
 
 void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const IntegrationConfig& config) {
-    auto hits = map.hits->getAccessor();
+    // Hits: activate every endpoint voxel (parallel topologyUnion), then add counts straight into
+    // the leaf buffers; groups come sorted, so consecutive groups mostly share a leaf.
+    openvdb::Int32Tree& hits = map.hits->tree();
+    hits.topologyUnion(*update.occupied);
+    openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
+    for (const EndpointGroup& g : update.endpoints) {
+        const openvdb::Coord origin(g.ijk.x() & ~7, g.ijk.y() & ~7, g.ijk.z() & ~7);
+        if (!leaf || origin != leaf->origin()) leaf = hits.probeLeaf(g.ijk);
+        leaf->buffer().data()[leaf->coordToOffset(g.ijk)] += g.points;
+    }
+
     auto label = map.label->getAccessor();
     auto weight = map.label_weight->getAccessor();
     for (const EndpointGroup& g : update.endpoints) {
-        hits.setValueOn(g.ijk, hits.getValue(g.ijk) + g.points);
         if (g.label == core::SemanticClass::kUnknown) continue;  // no evidence for any class
         // Weighted vote: agreeing evidence adds weight, disagreeing evidence removes it, and the
         // label flips only when the other class has outweighed it.
