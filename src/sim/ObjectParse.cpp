@@ -25,11 +25,7 @@ double Positive(JsonReader& r, const std::string& key, double fallback) {
 
 void ReadCommon(JsonReader& r, ObjectSpec& o, const char* default_class, float reflectivity) {
     o.name = r.Get<std::string>("name", "");
-    try {
-        o.label = kitti::IdFromName(r.Get<std::string>("class", default_class));
-    } catch (const std::invalid_argument& e) {
-        r.Fail(e.what());
-    }
+    o.label = ReadClass(r, "class", default_class);
     o.reflectivity = r.Get<float>("reflectivity", reflectivity);
     if (o.reflectivity < 0.0F || o.reflectivity > 1.0F) r.Fail("'reflectivity' must be in [0, 1]");
 }
@@ -46,14 +42,21 @@ SlabSpec ParseSlab(JsonReader& r) {
         s.holes.emplace_back(h.Vec2("min"), h.Vec2("max"));
         h.Finish();
     }
-    if (r.Has("side_class")) s.side_label = kitti::IdFromName(r.Require<std::string>("side_class"));
-    if (r.Has("bottom_class")) {
-        s.bottom_label = kitti::IdFromName(r.Require<std::string>("bottom_class"));
-    }
+    if (r.Has("side_class")) s.side_label = ReadClass(r, "side_class", "");
+    if (r.Has("bottom_class")) s.bottom_label = ReadClass(r, "bottom_class", "");
     return s;
 }
 
 }  // namespace
+
+uint16_t ReadClass(JsonReader& r, const std::string& key, const char* fallback) {
+    const std::string name = r.Get<std::string>(key, fallback);
+    try {
+        return kitti::IdFromName(name);
+    } catch (const std::invalid_argument& e) {
+        r.Fail("'" + key + "': " + e.what());
+    }
+}
 
 ObjectSpec ParseObject(JsonReader& r, const std::string& kind, SceneAssembler& a) {
     ObjectSpec o;

@@ -29,6 +29,9 @@ private:
 
 /// Object kinds of the scene file: "ground", "walls", "vehicles", "trees", "bushes", "poles",
 /// "boxes", "stairs" (the top-level keys, singular or plural).
+/// SemanticKITTI class of `key` (a name or an id), `fallback` when absent; errors name the key.
+[[nodiscard]] uint16_t ReadClass(JsonReader& r, const std::string& key, const char* fallback);
+
 [[nodiscard]] ObjectSpec ParseObject(JsonReader& r, const std::string& kind, SceneAssembler& a);
 [[nodiscard]] ObjectSpec ParseWall(JsonReader& r, SceneAssembler& a);
 /// Openings of a window grid over a wall path (skips windows that would straddle a corner).

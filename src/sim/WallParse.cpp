@@ -67,7 +67,7 @@ void AddWindowGrid(JsonReader& r, WallSpec& wall) {
 ObjectSpec ParseWall(JsonReader& r, SceneAssembler& a) {
     ObjectSpec o;
     o.name = r.Get<std::string>("name", "");
-    o.label = kitti::IdFromName(r.Get<std::string>("class", "building"));
+    o.label = ReadClass(r, "class", "building");
     o.reflectivity = r.Get<float>("reflectivity", 0.35F);
     WallSpec w;
     w.kind = KindFromName(r, r.Get<std::string>("kind", "flat"));

@@ -32,18 +32,21 @@ struct BoxTruth {
     double yaw_deg = 0.0;
 };
 
+/// @brief A storey of a building scene and the frame its session was recorded in.
 struct FloorTruth {
     int index = 0;
     double z_offset = 0.0;
     Eigen::Isometry3d T_world_floor = Eigen::Isometry3d::Identity();  ///< session frame of floor
 };
 
+/// @brief One change of a session relative to the session before.
 struct EditTruth {
     BoxTruth box;        ///< box.id is the object id
     std::string change;  ///< "added" or "removed" (a move is one of each)
     std::string kind;    ///< the scene edit: add, remove, move, demolish, grow
 };
 
+/// @brief A real gap in the ground (drain, ramp edge) that ground refill must leave empty.
 struct GapTruth {
     std::string name;
     std::string kind;

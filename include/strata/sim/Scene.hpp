@@ -24,6 +24,7 @@ struct Mesh {
 
     /// @brief Appends another mesh's triangles (same class assumed).
     void Append(const Mesh& other);
+    /// @brief Total area of the triangles in square metres.
     [[nodiscard]] double Area() const;
 };
 
@@ -33,6 +34,7 @@ struct Scene {
     GroundTruth truth;  ///< world frame
     Eigen::AlignedBox3d bounds;
 
+    /// @brief Triangles over all meshes.
     [[nodiscard]] size_t TriangleCount() const;
 };
 

@@ -37,6 +37,7 @@ struct SessionReport {
     double trace_seconds = 0.0;  ///< wall-clock time spent ray tracing sweeps
 };
 
+/// @brief What SimulateSceneToSequence wrote, one entry per session.
 struct SimulateReport {
     std::vector<SessionReport> sessions;
 };
