@@ -6,6 +6,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "strata/io/KittiSequence.hpp"
+#include "strata/io/PoseFiles.hpp"
+
 namespace strata::sim {
 namespace {
 
@@ -13,13 +16,6 @@ std::string FrameName(size_t index, const char* extension) {
     char name[32];
     std::snprintf(name, sizeof(name), "%06zu%s", index, extension);
     return name;
-}
-
-void WriteBinary(const std::filesystem::path& path, const void* data, size_t bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
-    out.close();
-    if (!out) throw std::runtime_error("cannot write " + path.string());
 }
 
 void WriteText(const std::filesystem::path& path, const std::string& text) {
@@ -52,28 +48,18 @@ SequenceWriter::SequenceWriter(std::filesystem::path dir) : dir_(std::move(dir))
 
 void SequenceWriter::Add(const SimulatedScan& scan, const Eigen::Isometry3d& T_session_sensor) {
     const size_t index = poses_.size();
-    const size_t n = scan.scan.points.size();
-    std::vector<float> xyzi(4 * n);
-    for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector3d& p = scan.scan.points[i];
-        xyzi[4 * i + 0] = static_cast<float>(p.x());
-        xyzi[4 * i + 1] = static_cast<float>(p.y());
-        xyzi[4 * i + 2] = static_cast<float>(p.z());
-        xyzi[4 * i + 3] = scan.scan.intensity.empty() ? 0.0F : scan.scan.intensity[i];
-    }
-    WriteBinary(dir_ / "velodyne" / FrameName(index, ".bin"), xyzi.data(), xyzi.size() * 4);
-    WriteBinary(dir_ / "labels" / FrameName(index, ".label"), scan.raw_labels.data(),
-                scan.raw_labels.size() * sizeof(uint32_t));
+    io::WriteKittiBin(dir_ / "velodyne" / FrameName(index, ".bin"), scan.scan.points,
+                      scan.scan.intensity);
+    io::WriteKittiLabels(dir_ / "labels" / FrameName(index, ".label"), scan.raw_labels);
     poses_.push_back(T_session_sensor);
     times_.push_back(scan.scan.time_s);
 }
 
 void SequenceWriter::Finish() const {
-    std::ostringstream poses, times;
-    for (const Eigen::Isometry3d& T : poses_) poses << Row3x4(T.matrix().topRows<3>()) << "\n";
+    io::WriteKittiPoses(dir_ / "poses.txt", poses_);
+    std::ostringstream times;
     times << std::scientific << std::setprecision(6);
     for (double t : times_) times << t << "\n";
-    WriteText(dir_ / "poses.txt", poses.str());
     WriteText(dir_ / "times.txt", times.str());
     // Tr is the identity: poses are LiDAR poses. P0..P3 describe a synthetic stereo rig
     // (f = 700 px, 0.54 m baseline as KITTI's) only so that KITTI readers find every line;
@@ -90,26 +76,6 @@ void SequenceWriter::Finish() const {
     }
     calib << "Tr: " << Row3x4(Eigen::Matrix<double, 3, 4>::Identity()) << "\n";
     WriteText(dir_ / "calib.txt", calib.str());
-}
-
-std::vector<Eigen::Isometry3d> ReadKittiPoses(const std::filesystem::path& path) {
-    std::ifstream in(path);
-    if (!in) throw std::runtime_error("cannot read " + path.string());
-    std::vector<Eigen::Isometry3d> poses;
-    std::string line;
-    for (size_t number = 1; std::getline(in, line); ++number) {
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        std::istringstream fields(line);
-        Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-        for (int k = 0; k < 12; ++k) {
-            if (!(fields >> m(k / 4, k % 4))) {
-                throw std::runtime_error(path.string() + ":" + std::to_string(number) +
-                                         ": expected 12 numbers");
-            }
-        }
-        poses.emplace_back(m);
-    }
-    return poses;
 }
 
 }  // namespace strata::sim

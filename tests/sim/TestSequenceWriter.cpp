@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "strata/io/PoseFiles.hpp"
+
 #include <fstream>
 #include <sstream>
 
@@ -47,7 +49,7 @@ TEST(SequenceWriter, WritesKittiFilesWhosePosesMapPointsBackToTheWorld) {
         writer.Add(scans.back(), T_world_session.inverse() * T_world_sensor);
     }
     writer.Finish();
-    const std::vector<Eigen::Isometry3d> poses = ReadKittiPoses(dir / "poses.txt");
+    const std::vector<Eigen::Isometry3d> poses = io::ReadKittiPoses(dir / "poses.txt");
     ASSERT_EQ(poses.size(), 3U);
     for (size_t k = 0; k < 3; ++k) {
         const SimulatedScan& s = scans[k];
@@ -74,7 +76,7 @@ TEST(SequenceWriter, WritesKittiFilesWhosePosesMapPointsBackToTheWorld) {
     double t0 = -1, t1 = -1, t2 = -1;
     times >> t0 >> t1 >> t2;
     EXPECT_DOUBLE_EQ(t2, 0.2);
-    EXPECT_THROW((void)ReadKittiPoses(dir / "missing.txt"), std::runtime_error);
+    EXPECT_THROW((void)io::ReadKittiPoses(dir / "missing.txt"), std::runtime_error);
     std::filesystem::remove_all(dir);
 }
 

@@ -118,4 +118,69 @@ TEST(Cli, FailedIntegrationLeavesTheMapUntouched) {
                      "--frames 0:2").code, 0);
 }
 
+TEST(Cli, IntegratesTextScansWithAPoseFile) {
+    const fs::path dir = Temp("text");
+    fs::create_directories(dir);
+    std::vector<Eigen::Isometry3d> poses;
+    for (int k = 0; k < 2; ++k) {
+        std::ofstream out(dir / ("scan" + std::to_string(k) + ".txt"));
+        out << "# a wall 4 m ahead\n";
+        for (int i = -20; i <= 20; ++i) {
+            for (int j = -10; j <= 10; ++j) out << 4.0 << " " << 0.1 * i << " " << 0.1 * j << "\n";
+        }
+        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+        T.translation() = Eigen::Vector3d(0.0, 0.5 * k, 0.0);
+        poses.push_back(T);
+    }
+    strata::io::WriteKittiPoses(dir / "poses.txt", poses);
+    const fs::path map = Temp("textmap");
+    const Result r = Strata("integrate " + map.string() + " --scans " + (dir / "scan0.txt").string() +
+                            " " + (dir / "scan1.txt").string() + " --poses " +
+                            (dir / "poses.txt").string() + " --voxel 0.1");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const auto loaded = strata::io::LoadMapDirectory(map);
+    ASSERT_EQ(loaded.sessions.at(0).scans, 2u);
+    // The second scan is 0.5 m to the side: the wall reaches y = 2.5 m, observed as occupied.
+    const auto ijk = loaded.map.WorldToVoxel({4.05, 2.45, 0.05});
+    EXPECT_GT(loaded.map.occupancy->tree().getValue(ijk), 0.0f);
+}
+
+TEST(Cli, IntegratesAGeoreferencedLasTileAsPointsOnly) {
+    const fs::path las = fs::path(STRATA_DATA_DIR) / "autzen_las" / "autzen_trim.las";
+    if (!fs::exists(las)) GTEST_SKIP() << "real data not found: " << las;
+    const fs::path map = Temp("las");
+    const Result r =
+        Strata("integrate " + map.string() + " --scans " + las.string() + " --points-only --voxel 2");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const Result info = Strata("info " + map.string() + " --json");
+    const auto j = nlohmann::json::parse(info.out.substr(info.out.find('{')));
+    // State-plane feet: the origin keeps the big numbers, the grid holds small ones.
+    EXPECT_GT(j["origin"][0].get<double>(), 1e5);
+    EXPECT_EQ(j["free_voxels"].get<size_t>(), 0u);
+    EXPECT_GT(j["occupied_voxels"].get<size_t>(), 1000u);
+    EXPECT_GE(j["classes"]["ground"].get<size_t>(), 1u);
+}
+
+TEST(Cli, SimulatedSequenceIntegratesEndToEnd) {
+    const fs::path scene = fs::path(STRATA_SOURCE_DIR) / "datasets" / "scenes" / "street.json";
+    const fs::path seq = Temp("simseq");
+    const Result sim = Strata("simulate --scene " + scene.string() + " --out " + seq.string() +
+                              " --sensor vlp16 --max-scans 2 --seed 3");
+    ASSERT_EQ(sim.code, 0) << sim.out;
+    std::ifstream truth_file(seq / "ground_truth.json");
+    const auto truth = nlohmann::json::parse(truth_file);
+    for (const char* key : {"walls", "vehicles", "floors", "edits", "static_surface"}) {
+        EXPECT_TRUE(truth.contains(key)) << key;
+    }
+    EXPECT_GE(truth["walls"].size(), 5u);
+    const fs::path map = Temp("simmap");
+    const Result integrate = Strata("integrate " + map.string() + " --kitti " + seq.string());
+    ASSERT_EQ(integrate.code, 0) << integrate.out;
+    const auto loaded = strata::io::LoadMapDirectory(map);
+    EXPECT_GT(loaded.map.label->activeVoxelCount(), 1000u);  // simulated scans carry labels
+    const Result bad = Strata("simulate --scene /nonexistent/scene.json --out " + seq.string());
+    EXPECT_NE(bad.code, 0);
+    EXPECT_NE(bad.out.find("/nonexistent/scene.json"), std::string::npos) << bad.out;
+}
+
 }  // namespace

@@ -39,7 +39,7 @@ struct Picture {
                                          const std::vector<ScanPose>& poses,
                                          const PictureConfig& config = {});
 
-/// @brief Writes an RGB PNG with libpng; throws std::runtime_error naming the file on failure.
+/// @brief Writes an RGB PNG (io::WritePng); throws std::runtime_error naming the file on failure.
 void WritePicturePng(const std::filesystem::path& path, const Picture& picture);
 
 }  // namespace strata::sim

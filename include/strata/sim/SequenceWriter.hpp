@@ -32,8 +32,4 @@ private:
     std::vector<double> times_;
 };
 
-/// @brief Reads poses.txt (KITTI: 12 numbers per line); throws std::runtime_error naming the
-/// file when it cannot be read or a line is malformed.
-[[nodiscard]] std::vector<Eigen::Isometry3d> ReadKittiPoses(const std::filesystem::path& path);
-
 }  // namespace strata::sim
