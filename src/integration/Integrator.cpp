@@ -31,12 +31,8 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
     for (size_t i = 0; i < keys.size();) {
         size_t j = i;
         while (j < keys.size() && keys[j] == keys[i]) ++j;
-        const auto pos = static_cast<int64_t>(keys[i] >> 8);
-        const int64_t xy = pos / box.nz;
         EndpointGroup g;
-        g.ijk = box.lo + openvdb::Coord(static_cast<int32_t>(xy / box.ny),
-                                        static_cast<int32_t>(xy % box.ny),
-                                        static_cast<int32_t>(pos % box.nz));
+        g.ijk = box.CoordOf(static_cast<int64_t>(keys[i] >> 8));
         g.points = static_cast<int32_t>(j - i);
         g.label = static_cast<core::SemanticClass>(keys[i] & 0xff);
         groups.push_back(g);

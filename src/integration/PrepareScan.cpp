@@ -59,12 +59,12 @@ RaySetup SetupRay(const PreparedScan& scan, size_t i) {
     if (scan.points_only || scan.kinds[i] == PointKind::kDropped) return ray;  // no steps
     const Eigen::Vector3d& end = scan.ends[i];
     const double s = scan.voxel_size;
-    const openvdb::Coord key_end = Key(end, 1.0 / s);
+    const openvdb::Coord key_end = Key(end, scan.inv_voxel_size);
     const openvdb::Coord& key_origin = scan.key_origin;
     ray.start = scan.box.Index(key_origin);
     const int64_t strides[3] = {scan.box.ny * scan.box.nz, scan.box.nz, 1};
     Eigen::Vector3d direction = end - scan.origin;
-    direction /= direction.norm();
+    direction *= 1.0 / direction.norm();
     for (int a = 0; a < 3; ++a) {
         const int delta = key_end[a] - key_origin[a];
         ray.steps += std::abs(delta);
@@ -93,6 +93,7 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
     scan.origin = origin_map;
     scan.key_origin = Key(origin_map, inv_voxel);
     scan.voxel_size = voxel_size;
+    scan.inv_voxel_size = inv_voxel;
     scan.points_only = config.points_only;
     const size_t n = points_map.size();
     scan.ends.resize(n);

@@ -23,6 +23,22 @@ struct VoxelBox {
     [[nodiscard]] int64_t Index(const openvdb::Coord& c) const {
         return ((c.x() - lo.x()) * ny + (c.y() - lo.y())) * nz + (c.z() - lo.z());
     }
+    /// Inverse of Index. Divides through a double reciprocal, corrected to the exact quotient
+    /// (an integer division costs tens of cycles; endpoint grouping does this per voxel).
+    [[nodiscard]] openvdb::Coord CoordOf(int64_t pos) const {
+        const int64_t xy = DivFloor(pos, nz);
+        const int64_t x = DivFloor(xy, ny);
+        return lo + openvdb::Coord(static_cast<int32_t>(x), static_cast<int32_t>(xy - x * ny),
+                                   static_cast<int32_t>(pos - xy * nz));
+    }
+
+private:
+    static int64_t DivFloor(int64_t a, int64_t b) {  // a >= 0, b > 0
+        auto q = static_cast<int64_t>(static_cast<double>(a) / static_cast<double>(b));
+        while (q * b > a) --q;
+        while ((q + 1) * b <= a) ++q;
+        return q;
+    }
 };
 
 /// One ray in voxel terms, ready for the DDA: the start index, per-axis step strides, and the
@@ -44,6 +60,7 @@ struct PreparedScan {
     Eigen::Vector3d origin;             // sensor origin, map frame
     openvdb::Coord key_origin;
     double voxel_size = 0.0;
+    double inv_voxel_size = 0.0;  // keys are floor(p * inv_voxel_size), as OctoMap's
     bool points_only = false;
     std::vector<Eigen::Vector3d> ends;  // per point: the point, or the ray clipped to max range
     std::vector<PointKind> kinds;       // per point
