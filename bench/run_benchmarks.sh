@@ -19,7 +19,8 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
   echo "(compiled without OpenMP, i.e. one thread). strata: \`Integrator::Integrate\` with TBB limited"
   echo "to 1 and 2 threads. Memory: \`OcTree::memoryUsage()\` vs the sum of \`memUsage()\` of our four"
   echo "grids (occupancy, label, label_weight, hits). Jaccard: occupied and free voxel sets, OctoMap's"
-  echo "pruned nodes expanded to voxels."
+  echo "pruned nodes expanded to voxels. Targets (issue 2) and where the time goes:"
+  echo "[integration.md, Speed](integration.md#speed)."
   echo
   "$build/bench/bench_integration" "$root/../shared/data"
   if [[ -x "$build/bench/bench_sim" ]]; then
