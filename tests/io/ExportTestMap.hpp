@@ -3,6 +3,8 @@
 
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include <atomic>
 #include <filesystem>
 #include <string>
@@ -88,5 +90,16 @@ public:
 private:
     fs::path path_;
 };
+
+/// Runs `write`, which must throw std::runtime_error whose message names `path`.
+template <typename WriteFn>
+void ExpectErrorNaming(const fs::path& path, WriteFn&& write) {
+    try {
+        write();
+        ADD_FAILURE() << "expected std::runtime_error for " << path;
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    }
+}
 
 }  // namespace strata::io::export_test

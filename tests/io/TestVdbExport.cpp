@@ -166,12 +166,7 @@ TEST(VdbExport, VdbPrintListsEveryGrid) {
 TEST(VdbExport, MissingDirectoryThrowsNamingThePath) {
     const ScratchDir dir("vdb_missing");
     const fs::path path = dir / "no/such/dir/map.vdb";
-    try {
-        WriteVdb(MakeExportTestMap(), path);
-        FAIL() << "expected std::runtime_error";
-    } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
-    }
+    ExpectErrorNaming(path, [&] { WriteVdb(MakeExportTestMap(), path); });
     EXPECT_EQ(dir.EntryCount(), 0);
 }
 
