@@ -83,6 +83,12 @@ void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
                          [&] { detail::ApplyEndpoints(update, map, config); });
 }
 
+void ApplyOccupancyUpdate(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
+                          const IntegrationConfig& config) {
+    config.Validate();
+    detail::ApplyOccupancy(update, occupancy, config);
+}
+
 Integrator::Integrator(core::VoxelMap& map, const IntegrationConfig& config)
     : map_(map), config_(config) {
     config_.Validate();

@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <random>
 
 #include "strata/io/KittiSequence.hpp"
-#include "strata/io/MapIo.hpp"
+#include "strata/store/MapStore.hpp"
 #include "strata/io/PoseFiles.hpp"
 
 namespace {
@@ -21,6 +23,24 @@ struct Result {
     int code = 0;
     std::string out;  // stdout and stderr together
 };
+
+using strata::store::MapStore;
+
+MapStore OpenForReading(const fs::path& map) { return MapStore::Open(map, MapStore::Access::kRead); }
+
+// Every tile file of a map with its bytes: equal before and after means the map is untouched.
+std::map<std::string, std::string> MapFiles(const fs::path& map) {
+    std::map<std::string, std::string> files;
+    for (const auto& e : fs::recursive_directory_iterator(map)) {
+        if (!e.is_regular_file() || e.path().filename() == "writer.lock") continue;
+        if (e.path().filename().string().rfind("catalog.sqlite", 0) == 0) continue;
+        std::ifstream in(e.path(), std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        files[fs::relative(e.path(), map).string()] = bytes.str();
+    }
+    return files;
+}
 
 Result Strata(const std::string& args) {
     const std::string cmd = std::string(STRATA_BINARY) + " " + args + " 2>&1";
@@ -105,14 +125,14 @@ TEST(Cli, FailedIntegrationLeavesTheMapUntouched) {
     const fs::path seq = MakeSequence(Temp("seq2"));
     const fs::path map = Temp("map2");
     ASSERT_EQ(Strata("integrate " + map.string() + " --kitti " + seq.string()).code, 0);
-    const auto before = fs::file_size(strata::io::MapGridFile(map));
+    const auto before = MapFiles(map);
     // A scan truncated mid-record: the second session must fail and change nothing.
     fs::resize_file(seq / "velodyne" / "000002.bin", 16 * 100 + 7);
     const Result r = Strata("integrate " + map.string() + " --kitti " + seq.string());
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("000002.bin"), std::string::npos) << r.out;
-    EXPECT_EQ(fs::file_size(strata::io::MapGridFile(map)), before);
-    EXPECT_EQ(strata::io::LoadMapDirectory(map).sessions.size(), 1u);
+    EXPECT_EQ(MapFiles(map), before);
+    EXPECT_EQ(OpenForReading(map).Latest().sessions.size(), 1u);
     // A different voxel size for an existing map is refused.
     EXPECT_NE(Strata("integrate " + map.string() + " --kitti " + seq.string() + " --voxel 0.5 "
                      "--frames 0:2").code, 0);
@@ -138,11 +158,13 @@ TEST(Cli, IntegratesTextScansWithAPoseFile) {
                             " " + (dir / "scan1.txt").string() + " --poses " +
                             (dir / "poses.txt").string() + " --voxel 0.1");
     ASSERT_EQ(r.code, 0) << r.out;
-    const auto loaded = strata::io::LoadMapDirectory(map);
-    ASSERT_EQ(loaded.sessions.at(0).scans, 2u);
+    const MapStore store = OpenForReading(map);
+    ASSERT_EQ(store.Latest().sessions.at(0).scans, 2u);
+    EXPECT_EQ(store.Scans(1).at(1).source, (dir / "scan1.txt").string());
     // The second scan is 0.5 m to the side: the wall reaches y = 2.5 m, observed as occupied.
-    const auto ijk = loaded.map.WorldToVoxel({4.05, 2.45, 0.05});
-    EXPECT_GT(loaded.map.occupancy->tree().getValue(ijk), 0.0f);
+    const auto loaded = store.LoadMap(store.Latest());
+    const auto ijk = loaded.WorldToVoxel({4.05, 2.45, 0.05});
+    EXPECT_GT(loaded.occupancy->tree().getValue(ijk), 0.0f);
 }
 
 TEST(Cli, IntegratesAGeoreferencedLasTileAsPointsOnly) {
@@ -176,8 +198,8 @@ TEST(Cli, SimulatedSequenceIntegratesEndToEnd) {
     const fs::path map = Temp("simmap");
     const Result integrate = Strata("integrate " + map.string() + " --kitti " + seq.string());
     ASSERT_EQ(integrate.code, 0) << integrate.out;
-    const auto loaded = strata::io::LoadMapDirectory(map);
-    EXPECT_GT(loaded.map.label->activeVoxelCount(), 1000u);  // simulated scans carry labels
+    const MapStore store = OpenForReading(map);
+    EXPECT_GT(store.LoadMap(store.Latest()).label->activeVoxelCount(), 1000u);  // labelled
     const Result bad = Strata("simulate --scene /nonexistent/scene.json --out " + seq.string());
     EXPECT_NE(bad.code, 0);
     EXPECT_NE(bad.out.find("/nonexistent/scene.json"), std::string::npos) << bad.out;

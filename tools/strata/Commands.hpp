@@ -11,5 +11,7 @@ void RegisterInfo(CLI::App& app);
 void RegisterExport(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
+void RegisterSession(CLI::App& app);
+void RegisterMaintenance(CLI::App& app);
 
 }  // namespace strata::tools

@@ -35,16 +35,22 @@ void Run(const DemoArgs& args) {
     }
     const fs::path map_dir = out / "map";
     fs::remove_all(map_dir);  // the demo always starts from an empty map
-    io::MapDirectory map{core::VoxelMap::Create(args.voxel), {}};
-    integration::IntegrationConfig config;
-    const auto session =
-        IntegrateSession(map, ScanSource::Kitti(sequence, ""), config, "demo");
-    io::SaveMapDirectory(map, map_dir);
-    io::WriteVdb(map.map, out / "map.vdb");
+    store::StoreSettings settings;
+    settings.voxel_size_m = args.voxel;
+    store::MapStore store = store::MapStore::Create(map_dir, settings);
+    const ScanSource source = ScanSource::Kitti(sequence, "");
+    store::SessionOptions options;
+    options.name = "demo";
+    options.source = source.Describe();
+    store::SessionWriter writer(store, integration::IntegrationConfig{}, options);
+    IntegrateScans(writer, source);
+    const store::SessionRecord session = writer.Commit();
+    const core::VoxelMap map = store.LoadMap(store.Latest());
+    io::WriteVdb(map, out / "map.vdb");
     io::TopDownOptions png;
     png.pixels_per_voxel = 2;
-    png.color_by_height = map.map.label->activeVoxelCount() == 0;  // unlabelled: show heights
-    io::WriteTopDownPng(map.map, out / "map.png", png);
+    png.color_by_height = map.label->activeVoxelCount() == 0;  // unlabelled: show heights
+    io::WriteTopDownPng(map, out / "map.png", png);
     std::cout << "integrated " << session.scans << " scans (" << session.points << " points) from "
               << sequence.string() << "\n"
               << "map:     " << map_dir.string() << "  (strata info " << map_dir.string() << ")\n"

@@ -20,6 +20,7 @@ struct ExportArgs {
     std::string out;
     int pixels_per_voxel = 2;
     std::string color = "auto";
+    std::string as_of;
 };
 
 void Run(const ExportArgs& args) {
@@ -31,24 +32,25 @@ void Run(const ExportArgs& args) {
         }
         format = ext.substr(1);
     }
-    const io::MapDirectory dir = OpenMap(args.map);
+    const store::MapStore store = OpenMap(args.map);
+    const core::VoxelMap map = store.LoadMap(SelectSnapshot(store, args.as_of));
     if (format == "vdb") {
-        io::WriteVdb(dir.map, args.out);
+        io::WriteVdb(map, args.out);
     } else if (format == "bt" || format == "ot") {
         if (std::filesystem::path(args.out).extension() != "." + format) {
             throw std::invalid_argument("--out " + args.out + ": OctoMap files must end in ." +
                                         format);
         }
-        io::WriteOctomap(dir.map, args.out);
+        io::WriteOctomap(map, args.out);
     } else if (format == "ply") {
-        io::WritePly(dir.map, args.out);
+        io::WritePly(map, args.out);
     } else if (format == "png") {
         io::TopDownOptions options;
         options.pixels_per_voxel = args.pixels_per_voxel;
         // Unlabelled maps carry no class colours: show heights instead.
         options.color_by_height = args.color == "height" ||
-                                  (args.color == "auto" && dir.map.label->activeVoxelCount() == 0);
-        io::WriteTopDownPng(dir.map, args.out, options);
+                                  (args.color == "auto" && map.label->activeVoxelCount() == 0);
+        io::WriteTopDownPng(map, args.out, options);
     } else {
         throw std::invalid_argument("unknown export format '" + format +
                                     "' (use vdb, bt, ot, ply or png)");
@@ -77,6 +79,7 @@ void RegisterExport(CLI::App& app) {
                                             "the map has no labels)")
         ->check(CLI::IsMember({"auto", "class", "height"}))
         ->capture_default_str();
+    cmd->add_option("--as-of", args->as_of, "Export the map as it was right after this session");
     cmd->callback([args] { Run(*args); });
 }
 

@@ -1,6 +1,7 @@
 // strata info: what a map holds (voxel size, observed voxels, classes, extents, sizes, sessions).
 #include <cmath>
 #include <filesystem>
+#include <cstdint>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -14,8 +15,23 @@ namespace strata::tools {
 
 namespace {
 
-nlohmann::json Describe(const io::MapDirectory& dir, const std::filesystem::path& path) {
-    const core::VoxelMap& map = dir.map;
+namespace fs = std::filesystem;
+
+// Bytes of every file under `dir`.
+uint64_t DiskUse(const fs::path& dir) {
+    uint64_t bytes = 0;
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(dir, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        std::error_code ignored;
+        if (it->is_regular_file(ignored)) bytes += it->file_size(ignored);
+    }
+    return bytes;
+}
+
+nlohmann::json Describe(const store::MapStore& store, const std::string& as_of) {
+    const store::Snapshot snapshot = SelectSnapshot(store, as_of);
+    const core::VoxelMap map = store.LoadMap(snapshot);
     size_t occupied = 0, free = 0;
     std::map<std::string, size_t> classes;
     auto label = map.label->getConstAccessor();
@@ -31,7 +47,11 @@ nlohmann::json Describe(const io::MapDirectory& dir, const std::filesystem::path
                                            : core::SemanticClass::kUnknown)];
     }
     nlohmann::json j;
-    j["map"] = path.string();
+    j["map"] = store.dir().string();
+    j["commit"] = snapshot.commit;
+    if (!as_of.empty()) j["as_of"] = as_of;
+    j["tile_size_m"] = store.settings().tile_size_m();
+    j["format_version"] = store.settings().format_version;
     j["voxel_size_m"] = map.voxel_size;
     j["origin"] = {map.origin.x(), map.origin.y(), map.origin.z()};
     j["occupied_voxels"] = occupied;
@@ -50,18 +70,26 @@ nlohmann::json Describe(const io::MapDirectory& dir, const std::filesystem::path
     size_t memory = 0;
     for (const auto& g : map.Grids()) memory += g->memUsage();
     j["memory_bytes"] = memory;
-    j["file_bytes"] = std::filesystem::file_size(io::MapGridFile(path));
+    uint64_t tile_bytes = 0;
+    for (const store::TileVersion& t : snapshot.tiles) tile_bytes += t.bytes;
+    j["tiles"] = snapshot.tiles.size();
+    j["tile_bytes"] = tile_bytes;          // the tiles this snapshot reads
+    j["tile_versions"] = store.TileFileCount();        // every version kept, history included
+    j["disk_bytes"] = DiskUse(store.dir());  // catalog, all versions, garbage
     j["sessions"] = nlohmann::json::array();
-    for (const auto& s : dir.sessions) {
+    for (const auto& s : snapshot.sessions) {
         j["sessions"].push_back({{"id", s.id}, {"name", s.name}, {"source", s.source},
                                  {"scans", s.scans}, {"points", s.points},
-                                 {"created_utc", s.created_utc}});
+                                 {"start_utc", s.start_utc}, {"end_utc", s.end_utc},
+                                 {"commit", s.commit}});
     }
     return j;
 }
 
 void PrintText(const nlohmann::json& j) {
-    std::cout << "map          " << j["map"].get<std::string>() << "\n"
+    std::cout << "map          " << j["map"].get<std::string>() << " (commit " << j["commit"]
+              << (j.contains("as_of") ? ", as of session " + j["as_of"].get<std::string>() : "")
+              << ")\n"
               << "voxel size   " << j["voxel_size_m"] << " m\n"
               << "origin       " << j["origin"].dump() << "\n"
               << "occupied     " << j["occupied_voxels"] << " voxels\n"
@@ -70,8 +98,11 @@ void PrintText(const nlohmann::json& j) {
         std::cout << "extent       " << j["extent_min"].dump() << " .. " << j["extent_max"].dump()
                   << " m\n";
     }
-    std::cout << "memory       " << j["memory_bytes"].get<size_t>() / 1e6 << " MB in RAM, "
-              << j["file_bytes"].get<size_t>() / 1e6 << " MB on disk\n"
+    std::cout << "tiles        " << j["tiles"] << " of " << j["tile_size_m"] << " m ("
+              << j["tile_bytes"].get<uint64_t>() / 1e6 << " MB), " << j["tile_versions"]
+              << " versions kept\n"
+              << "memory       " << j["memory_bytes"].get<size_t>() / 1e6 << " MB in RAM, "
+              << j["disk_bytes"].get<uint64_t>() / 1e6 << " MB on disk\n"
               << "classes (occupied voxels):\n";
     for (const auto& [name, count] : j["classes"].items()) {
         std::cout << "  " << name << ": " << count << "\n";
@@ -80,7 +111,7 @@ void PrintText(const nlohmann::json& j) {
     for (const auto& s : j["sessions"]) {
         std::cout << "  " << s["id"] << " " << s["name"].get<std::string>() << ": " << s["scans"]
                   << " scans, " << s["points"] << " points from " << s["source"].get<std::string>()
-                  << " (" << s["created_utc"].get<std::string>() << ")\n";
+                  << " (" << s["end_utc"].get<std::string>() << ")\n";
     }
 }
 
@@ -88,13 +119,16 @@ void PrintText(const nlohmann::json& j) {
 
 void RegisterInfo(CLI::App& app) {
     auto map = std::make_shared<std::string>();
+    auto as_of = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand("info", "Show what a map holds");
-    cmd->footer("Example:\n  strata info city.strata --json | jq .classes");
+    cmd->footer("Examples:\n  strata info city.strata --json | jq .classes\n"
+                "  strata info city.strata --as-of 2");
     cmd->add_option("MAP", *map, "Map directory")->required();
     cmd->add_flag("--json", *json, "Print JSON");
-    cmd->callback([map, json] {
-        const auto j = Describe(OpenMap(*map), *map);
+    cmd->add_option("--as-of", *as_of, "Show the map as it was right after this session (id or name)");
+    cmd->callback([map, as_of, json] {
+        const auto j = Describe(OpenMap(*map), *as_of);
         if (*json) {
             std::cout << j.dump(2) << "\n";
         } else {

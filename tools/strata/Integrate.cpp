@@ -5,6 +5,7 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
@@ -23,6 +24,8 @@ struct IntegrateArgs {
     std::string name;
     std::vector<double> origin;
     double voxel = 0.2;
+    double tile_size = 64.0;
+    double memory_budget_mb = 0.0;
     int threads = 0;
     integration::IntegrationConfig config;
 };
@@ -33,10 +36,45 @@ bool IsLas(const std::string& path) {
     return ext == ".las";
 }
 
+void Integrate(const IntegrateArgs& args, store::MapStore& map, bool existed) {
+    const store::MapSettings& settings = map.settings();
+    io::ReadOptions read_options;
+    read_options.origin = settings.origin;
+    const ScanSource source =
+        args.kitti.empty()
+            ? ScanSource::Files({args.scans.begin(), args.scans.end()}, args.poses, read_options)
+            : ScanSource::Kitti(args.kitti, args.frames);
+    store::SessionOptions options;
+    options.name = args.name;
+    options.source = source.Describe();
+    options.memory_budget_bytes = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    // The effective configuration, so every map can be reproduced.
+    std::cerr << "strata integrate: " << source.size() << " scans from " << source.Describe()
+              << " into " << args.map << (existed ? "" : " (new)") << ", voxel "
+              << settings.voxel_size_m << " m, tiles " << settings.tile_size_m() << " m, range ["
+              << args.config.min_range_m << ", " << args.config.max_range_m << "] m"
+              << (args.config.points_only ? ", points only" : "") << ", threads "
+              << (args.threads > 0 ? std::to_string(args.threads) : "all") << "\n";
+
+    const auto start = std::chrono::steady_clock::now();
+    store::SessionWriter writer(map, args.config, options);
+    IntegrateScans(writer, source);
+    const store::SessionRecord session = writer.Commit();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const store::WriterStats& stats = writer.stats();
+    std::cout << "session " << session.id << " (" << session.name << "): " << session.scans
+              << " scans, " << session.points << " points in " << seconds << " s; wrote "
+              << stats.tiles_written << " tile files (" << stats.bytes_written / 1e6
+              << " MB), commit " << stats.commit_seconds << " s; map has "
+              << map.Latest().tiles.size() << " tiles\n";
+}
+
 void Run(const IntegrateArgs& args, const CLI::App& cmd) {
     if (args.kitti.empty() == args.scans.empty()) {
         throw std::invalid_argument("give exactly one of --kitti SEQ or --scans FILES...");
     }
+    if (args.memory_budget_mb < 0.0) throw std::invalid_argument("--memory-budget must be >= 0");
     std::unique_ptr<tbb::global_control> limit;
     if (args.threads > 0) {
         limit = std::make_unique<tbb::global_control>(
@@ -44,47 +82,39 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
     }
     args.config.Validate();
 
-    const bool exists = io::IsMapDirectory(args.map);
-    io::MapDirectory map;
+    const bool exists = store::MapStore::IsMap(args.map);
+    std::optional<store::MapStore> map;
     if (exists) {
-        map = io::LoadMapDirectory(args.map);
-        if (cmd.count("--voxel") && std::abs(map.map.voxel_size - args.voxel) > 1e-12) {
-            throw std::invalid_argument(args.map + " has voxel size " +
-                                        std::to_string(map.map.voxel_size) + " m; --voxel " +
-                                        std::to_string(args.voxel) + " cannot change it");
+        map.emplace(store::MapStore::Open(args.map, store::MapStore::Access::kWrite));
+        const double voxel = map->settings().voxel_size_m;
+        if (cmd.count("--voxel") && std::abs(voxel - args.voxel) > 1e-12) {
+            throw std::invalid_argument(args.map + " has voxel size " + std::to_string(voxel) +
+                                        " m; --voxel " + std::to_string(args.voxel) +
+                                        " cannot change it");
         }
     } else {
-        Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+        store::StoreSettings settings;
+        settings.voxel_size_m = args.voxel;
+        settings.tile_size_m = args.tile_size;
         if (!args.origin.empty()) {
-            origin = Eigen::Vector3d(args.origin[0], args.origin[1], args.origin[2]);
+            settings.origin = Eigen::Vector3d(args.origin[0], args.origin[1], args.origin[2]);
         } else if (!args.scans.empty() && IsLas(args.scans.front())) {
             // Georeferenced input: keep coordinates small (float32 at UTM scale loses decimetres).
-            origin = io::ReadLasHeader(args.scans.front()).min.array().floor().matrix();
+            settings.origin = io::ReadLasHeader(args.scans.front()).min.array().floor().matrix();
         }
-        map.map = core::VoxelMap::Create(args.voxel, origin);
+        map.emplace(store::MapStore::Create(args.map, settings));
     }
-
-    io::ReadOptions read_options;
-    read_options.origin = map.map.origin;
-    const ScanSource source =
-        args.kitti.empty()
-            ? ScanSource::Files({args.scans.begin(), args.scans.end()}, args.poses, read_options)
-            : ScanSource::Kitti(args.kitti, args.frames);
-    // The effective configuration, so every map can be reproduced.
-    std::cerr << "strata integrate: " << source.size() << " scans from " << source.Describe()
-              << " into " << args.map << (exists ? "" : " (new)") << ", voxel "
-              << map.map.voxel_size << " m, range [" << args.config.min_range_m << ", "
-              << args.config.max_range_m << "] m" << (args.config.points_only ? ", points only" : "")
-              << ", threads " << (args.threads > 0 ? std::to_string(args.threads) : "all") << "\n";
-
-    const auto start = std::chrono::steady_clock::now();
-    const io::MapSession session = IntegrateSession(map, source, args.config, args.name);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    io::SaveMapDirectory(map, args.map);  // only now: a failure above leaves the map untouched
-    std::cout << "session " << session.id << " (" << session.name << "): " << session.scans
-              << " scans, " << session.points << " points in " << seconds << " s; map has "
-              << map.map.occupancy->activeVoxelCount() << " observed voxels\n";
+    try {
+        Integrate(args, *map, exists);
+    } catch (...) {
+        // A map this command created holds nothing else: leave no empty map behind.
+        if (!exists) {
+            map.reset();
+            std::error_code ignored;
+            std::filesystem::remove_all(args.map, ignored);
+        }
+        throw;
+    }
 }
 
 }  // namespace
@@ -96,7 +126,8 @@ void RegisterIntegrate(CLI::App& app) {
         "Examples:\n"
         "  strata integrate city.strata --kitti ../shared/data/kitti00 --frames 0:6 --voxel 0.2\n"
         "  strata integrate garage.strata --scans a.pcd b.pcd --poses poses.txt\n"
-        "  strata integrate tile.strata --scans autzen.las --points-only --voxel 1.0");
+        "  strata integrate tile.strata --scans autzen.las --points-only --voxel 1.0\n"
+        "Each run adds one session; the map changes only once every scan is integrated.");
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     cmd->add_option("--kitti", args->kitti, "KITTI/SemanticKITTI sequence folder");
     cmd->add_option("--frames", args->frames, "Frame range A:B of the sequence (half-open)");
@@ -106,6 +137,11 @@ void RegisterIntegrate(CLI::App& app) {
     cmd->add_option("--origin", args->origin, "Map origin x,y,z for a new map (georeferenced data)")
         ->expected(3)->delimiter(',');
     cmd->add_option("--voxel", args->voxel, "Voxel size in metres for a new map")->capture_default_str();
+    cmd->add_option("--tile-size", args->tile_size, "Tile edge in metres for a new map")
+        ->capture_default_str();
+    cmd->add_option("--memory-budget", args->memory_budget_mb,
+                    "Keep at most this many MB of tiles in memory (0 = no limit)")
+        ->capture_default_str();
     cmd->add_option("--max-range", args->config.max_range_m, "Max range in metres")->capture_default_str();
     cmd->add_option("--min-range", args->config.min_range_m, "Min range in metres")->capture_default_str();
     cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->capture_default_str();

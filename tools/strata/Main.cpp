@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
     strata::tools::RegisterIntegrate(app);
     strata::tools::RegisterInfo(app);
     strata::tools::RegisterExport(app);
+    strata::tools::RegisterSession(app);
+    strata::tools::RegisterMaintenance(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     try {

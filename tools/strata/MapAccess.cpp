@@ -1,7 +1,6 @@
 #include "MapAccess.hpp"
 
 #include <cstdlib>
-#include <ctime>
 #include <stdexcept>
 
 namespace strata::tools {
@@ -16,21 +15,16 @@ fs::path FindDataDir() {
     return {};
 }
 
-io::MapDirectory OpenMap(const fs::path& dir) {
-    if (!io::IsMapDirectory(dir)) {
+store::MapStore OpenMap(const fs::path& dir) {
+    if (!fs::exists(dir)) {
         throw std::runtime_error(dir.string() + ": no map here (create one with `strata integrate " +
                                  dir.string() + " --kitti SEQ`)");
     }
-    return io::LoadMapDirectory(dir);
+    return store::MapStore::Open(dir, store::MapStore::Access::kRead);
 }
 
-std::string UtcNow() {
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&now, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
+store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of) {
+    return as_of.empty() ? map.Latest() : map.AsOf(map.FindSession(as_of));
 }
 
 }  // namespace strata::tools

@@ -1,10 +1,10 @@
 #pragma once
-// Shared by subcommands: where data lives and how a map is opened.
+// Shared by subcommands: where data lives and how a map is opened and read.
 
 #include <filesystem>
 #include <string>
 
-#include "strata/io/MapIo.hpp"
+#include "strata/store/MapStore.hpp"
 
 namespace strata::tools {
 
@@ -12,10 +12,11 @@ namespace strata::tools {
 /// from the executable's source checkout. Empty when none exists.
 [[nodiscard]] std::filesystem::path FindDataDir();
 
-/// Loads MAP, failing with a message that says how to create one.
-[[nodiscard]] io::MapDirectory OpenMap(const std::filesystem::path& dir);
+/// Opens MAP for reading, failing with a message that says how to create one.
+[[nodiscard]] store::MapStore OpenMap(const std::filesystem::path& dir);
 
-/// Current UTC time as ISO 8601.
-[[nodiscard]] std::string UtcNow();
+/// The commit a read command shows: the newest, or the one right after session `as_of` (an id
+/// or a name) when given.
+[[nodiscard]] store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of);
 
 }  // namespace strata::tools

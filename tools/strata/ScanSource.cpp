@@ -2,7 +2,6 @@
 
 #include <stdexcept>
 
-#include "MapAccess.hpp"
 #include "Progress.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/PoseFiles.hpp"
@@ -71,24 +70,20 @@ std::string ScanSource::Describe() const {
     return files_.empty() ? std::string() : files_.front().string();
 }
 
-io::MapSession IntegrateSession(io::MapDirectory& map, const ScanSource& source,
-                                const integration::IntegrationConfig& config,
-                                const std::string& name) {
-    integration::Integrator integrator(map.map, config);
-    io::MapSession session;
-    session.id = map.sessions.empty() ? 1 : map.sessions.back().id + 1;
-    session.name = name.empty() ? "session_" + std::to_string(session.id) : name;
-    session.source = source.Describe();
-    session.created_utc = UtcNow();
+std::string ScanSource::FileOf(size_t i) const {
+    return (kitti_ ? kitti_->scan_files.at(indices_.at(i)) : files_.at(i)).string();
+}
+
+double ScanSource::TimeOf(size_t i) const {
+    return kitti_ && indices_.at(i) < kitti_->times_s.size() ? kitti_->times_s[indices_[i]] : 0.0;
+}
+
+void IntegrateScans(store::SessionWriter& writer, const ScanSource& source) {
     Progress progress("integrating", source.size());
     for (size_t i = 0; i < source.size(); ++i) {
-        const auto update = integrator.Integrate(source.Read(i));
-        session.points += update.points - update.dropped;
-        ++session.scans;
+        (void)writer.Integrate(source.Read(i), source.TimeOf(i), source.FileOf(i));
         progress.Advance();
     }
-    map.sessions.push_back(session);
-    return session;
 }
 
 }  // namespace strata::tools

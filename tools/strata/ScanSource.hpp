@@ -9,8 +9,8 @@
 #include "strata/core/Scan.hpp"
 #include "strata/integration/IntegrationConfig.hpp"
 #include "strata/io/KittiSequence.hpp"
-#include "strata/io/MapIo.hpp"
 #include "strata/io/PointCloudReaders.hpp"
+#include "strata/store/SessionWriter.hpp"
 
 namespace strata::tools {
 
@@ -24,6 +24,9 @@ public:
 
     [[nodiscard]] size_t size() const { return indices_.size(); }
     [[nodiscard]] core::Scan Read(size_t i) const;
+    /// The file scan `i` comes from and its time in seconds (0 when unknown).
+    [[nodiscard]] std::string FileOf(size_t i) const;
+    [[nodiscard]] double TimeOf(size_t i) const;
     [[nodiscard]] std::string Describe() const;
 
 private:
@@ -34,9 +37,7 @@ private:
     io::ReadOptions options_;
 };
 
-/// Integrates every scan of `source` into `map` as a new session (with a progress bar).
-io::MapSession IntegrateSession(io::MapDirectory& map, const ScanSource& source,
-                                const integration::IntegrationConfig& config,
-                                const std::string& name);
+/// Integrates every scan of `source` through `writer` (with a progress bar); does not commit.
+void IntegrateScans(store::SessionWriter& writer, const ScanSource& source);
 
 }  // namespace strata::tools

@@ -40,6 +40,11 @@ struct ScanUpdate {
 void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
                      const IntegrationConfig& config);
 
+/// @brief Applies only the log-odds part of an update to one occupancy grid (a session's own
+/// layer, for instance).
+void ApplyOccupancyUpdate(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
+                          const IntegrationConfig& config);
+
 /// @brief Integrates scans one by one into a map it does not own.
 class Integrator {
 public:

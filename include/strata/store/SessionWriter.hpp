@@ -1,0 +1,72 @@
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "strata/core/Scan.hpp"
+#include "strata/integration/Integrator.hpp"
+#include "strata/store/MapStore.hpp"
+
+namespace strata::store {
+
+/// @brief How a session is written.
+struct SessionOptions {
+    std::string name;    ///< default: session_<id>
+    std::string source;  ///< where the scans came from
+    std::string sensor;
+    std::string notes;
+    Eigen::Matrix4d alignment = Eigen::Matrix4d::Identity();
+    /// Tiles in memory are evicted (written to their next version, read back when a later scan
+    /// touches them) to stay under this many bytes; 0 keeps every touched tile in memory.
+    size_t memory_budget_bytes = 0;
+    /// For fault-injection tests: called at each step of Commit ("tiles_written",
+    /// "tiles_synced", "catalog_written" inside the open transaction); a throw aborts the commit
+    /// there.
+    std::function<void(const std::string& step)> fault_hook;
+};
+
+/// @brief What a session writer did, for progress reports and benchmarks.
+struct WriterStats {
+    size_t tiles_loaded = 0;   ///< read from the map (or back from an eviction)
+    size_t tiles_evicted = 0;  ///< moved out of memory to honour the budget
+    size_t tiles_written = 0;  ///< tile files written, evictions included
+    uint64_t bytes_written = 0;
+    size_t peak_memory_bytes = 0;  ///< largest working set seen (grids of loaded tiles)
+    double commit_seconds = 0.0;
+};
+
+/// @brief Integrates one session into a map opened for writing, tile by tile, and commits it:
+/// the touched tiles' new versions are written (temporary file, fsync, rename, directory fsync),
+/// then recorded with the session and its scans in one SQLite transaction. Untouched tiles are
+/// not rewritten. Until Commit returns, the map on disk is unchanged for every reader; a writer
+/// destroyed without committing removes the files it wrote.
+///
+/// Besides the fused grids, each touched tile gets this session's layers
+/// `session_<id>_occupied` / `session_<id>_free`: the voxels whose log-odds over this session's
+/// scans alone ended above / at or below zero.
+class SessionWriter {
+public:
+    /// @throw std::logic_error when the store is not open for writing; std::invalid_argument on
+    /// an invalid config.
+    SessionWriter(MapStore& store, const integration::IntegrationConfig& config,
+                  SessionOptions options);
+    ~SessionWriter();
+    SessionWriter(const SessionWriter&) = delete;
+    SessionWriter& operator=(const SessionWriter&) = delete;
+
+    /// Integrates one scan (and records it with `time_s` and `source` in the session's scans).
+    integration::ScanUpdate Integrate(const core::Scan& scan, double time_s = 0.0,
+                                      const std::string& source = {});
+    /// Writes and records the session; the writer cannot be used afterwards.
+    SessionRecord Commit();
+
+    [[nodiscard]] int64_t session_id() const;
+    [[nodiscard]] const WriterStats& stats() const;
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+}  // namespace strata::store

@@ -1,0 +1,456 @@
+#include "strata/store/MapStore.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <tbb/parallel_for.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+
+#include "store/Catalog.hpp"
+#include "store/MapStoreImpl.hpp"
+#include "store/TileFile.hpp"
+#include "store/TileSplit.hpp"
+#include "strata/integration/IntegrationConfig.hpp"
+
+namespace strata::store {
+namespace {
+
+namespace fs = std::filesystem;
+using detail::Database;
+using detail::Transaction;
+
+constexpr const char* kCatalog = "catalog.sqlite";
+constexpr const char* kLockFile = "writer.lock";
+constexpr const char* kProducer = "strata 0.1.0";
+
+std::string UtcNow() {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buf;
+}
+
+int64_t FloorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+// Writable for us: the kernel agrees, and someone has a write bit (root ignores permission bits,
+// but a map its owner made read-only stays read-only for strata too).
+bool Writable(const fs::path& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return false;
+    return ::access(path.c_str(), W_OK) == 0 && (st.st_mode & 0222) != 0;
+}
+
+// Takes the writer lock or explains who holds it.
+int TakeWriterLock(const fs::path& dir) {
+    const fs::path file = dir / kLockFile;
+    const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        throw std::runtime_error(dir.string() + ": cannot open " + kLockFile + " (" +
+                                 std::strerror(errno) + ")");
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        char pid[32] = {};
+        const ssize_t n = ::pread(fd, pid, sizeof(pid) - 1, 0);
+        ::close(fd);
+        std::string holder = n > 0 ? std::string(pid, static_cast<size_t>(n)) : "";
+        holder.erase(std::remove(holder.begin(), holder.end(), '\n'), holder.end());
+        throw std::runtime_error(dir.string() + ": another strata process" +
+                                 (holder.empty() ? "" : " (pid " + holder + ")") +
+                                 " is writing this map; one writer at a time, try again when it "
+                                 "has finished");
+    }
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd, 0) != 0 ||
+        ::pwrite(fd, pid.data(), pid.size(), 0) != static_cast<ssize_t>(pid.size())) {
+        // Only the message of a second writer would lack the pid; the lock itself holds.
+    }
+    return fd;
+}
+
+void RequireMapDirectory(const fs::path& dir) {
+    if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": no such map directory");
+    if (fs::exists(dir / kCatalog)) return;
+    if (fs::exists(dir / "map.vdb")) {
+        throw std::runtime_error(dir.string() +
+                                 ": a single-file map from an earlier strata (map.vdb, no "
+                                 "catalog); integrate its scans into a new map");
+    }
+    throw std::runtime_error(dir.string() + ": not a strata map (no " + kCatalog + ")");
+}
+
+int32_t TileVoxels(const StoreSettings& s) {
+    if (!(s.voxel_size_m > 0.0) || !std::isfinite(s.voxel_size_m)) {
+        throw std::invalid_argument("voxel size must be positive");
+    }
+    if (!(s.tile_size_m > 0.0) || !std::isfinite(s.tile_size_m)) {
+        throw std::invalid_argument("tile size must be positive");
+    }
+    const double leaves = std::round(s.tile_size_m / s.voxel_size_m / 8.0);
+    if (leaves > 1 << 20) throw std::invalid_argument("tile size is too large for the voxel size");
+    return static_cast<int32_t>(std::max(1.0, leaves)) * 8;
+}
+
+}  // namespace
+
+// ---- settings ------------------------------------------------------------------------------
+
+TileKey MapSettings::TileOf(const openvdb::Coord& ijk) const {
+    return {static_cast<int32_t>(FloorDiv(ijk.x(), tile_voxels)),
+            static_cast<int32_t>(FloorDiv(ijk.y(), tile_voxels))};
+}
+
+openvdb::CoordBBox MapSettings::TileBounds(const TileKey& key) const {
+    const int32_t lo = std::numeric_limits<int32_t>::min();
+    const int32_t hi = std::numeric_limits<int32_t>::max();
+    return {openvdb::Coord(key.x * tile_voxels, key.y * tile_voxels, lo),
+            openvdb::Coord((key.x + 1) * tile_voxels - 1, (key.y + 1) * tile_voxels - 1, hi)};
+}
+
+// ---- Impl ----------------------------------------------------------------------------------
+
+MapStore::Impl::~Impl() {
+    if (lock_fd >= 0) ::close(lock_fd);  // releases the flock
+}
+
+void MapStore::Impl::RequireWriter(const char* what) const {
+    if (!writer) {
+        throw std::logic_error(std::string(what) + " needs the map opened for writing");
+    }
+}
+
+std::string MapStore::Impl::TileFile(const TileKey& key, int64_t version) const {
+    return "tiles/" + std::to_string(key.x) + "_" + std::to_string(key.y) + "/v" +
+           std::to_string(version) + ".vdb";
+}
+
+fs::path MapStore::Impl::TileDir(const TileKey& key) const {
+    return dir / "tiles" / (std::to_string(key.x) + "_" + std::to_string(key.y));
+}
+
+Snapshot MapStore::Impl::SnapshotAt(int64_t commit) const {
+    // One read transaction: the sessions and tiles belong to the same commit even while a
+    // writer commits.
+    Transaction tx(*db, Transaction::Kind::kRead);
+    Snapshot s;
+    s.commit = commit > 0 ? commit : detail::LatestCommit(*db);
+    s.sessions = detail::ReadSessions(*db, s.commit);
+    s.tiles = detail::ReadTiles(*db, s.commit);
+    tx.Commit();
+    return s;
+}
+
+// ---- MapStore ------------------------------------------------------------------------------
+
+MapStore::MapStore(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+MapStore::MapStore(MapStore&&) noexcept = default;
+MapStore& MapStore::operator=(MapStore&&) noexcept = default;
+MapStore::~MapStore() = default;
+
+bool MapStore::IsMap(const fs::path& dir) { return fs::is_regular_file(dir / kCatalog); }
+
+MapStore MapStore::Create(const fs::path& dir, const StoreSettings& settings) {
+    const int32_t tile_voxels = TileVoxels(settings);
+    if (!settings.origin.allFinite()) throw std::invalid_argument("map origin must be finite");
+    std::error_code ec;
+    if (fs::exists(dir) && !(fs::is_directory(dir) && fs::is_empty(dir, ec))) {
+        throw std::runtime_error(dir.string() + ": exists and is not an empty directory");
+    }
+    const fs::path parent = fs::absolute(dir).parent_path();
+    fs::create_directories(parent, ec);
+    if (ec) throw std::runtime_error(parent.string() + ": cannot create (" + ec.message() + ")");
+    // Built beside its final place and renamed: a map directory is complete or absent.
+    const fs::path tmp = parent / ("." + fs::absolute(dir).filename().string() + ".creating-" +
+                                   std::to_string(::getpid()));
+    fs::remove_all(tmp, ec);
+    try {
+        fs::create_directories(tmp / "tiles");
+        {
+            Database db(tmp / kCatalog, Database::Mode::kCreate);
+            db.Exec("PRAGMA journal_mode = WAL");
+            detail::MigrateCatalog(db);
+            MapSettings s;
+            s.voxel_size_m = settings.voxel_size_m;
+            s.tile_voxels = tile_voxels;
+            s.origin = settings.origin;
+            s.format_version = kFormatVersion;
+            s.created_by = kProducer;
+            s.created_utc = UtcNow();
+            Transaction tx(db, Transaction::Kind::kWrite);
+            detail::WriteSettings(db, s);
+            detail::InsertCommit(db, "create", 0);
+            tx.Commit();
+        }
+        detail::SyncDirectory(tmp / "tiles");
+        detail::SyncDirectory(tmp);
+        fs::rename(tmp, dir);
+        detail::SyncDirectory(parent);
+    } catch (const std::exception& e) {
+        fs::remove_all(tmp, ec);
+        throw std::runtime_error(dir.string() + ": cannot create the map (" + e.what() + ")");
+    }
+    return Open(dir, Access::kWrite);
+}
+
+MapStore MapStore::Open(const fs::path& dir, Access access) {
+    RequireMapDirectory(dir);
+    openvdb::initialize();
+    auto impl = std::make_unique<Impl>();
+    impl->dir = dir;
+    const fs::path catalog = dir / kCatalog;
+    if (access == Access::kWrite) {
+        if (!Writable(dir) || !Writable(catalog)) {
+            throw std::runtime_error(dir.string() + ": the map is read-only (no write permission)");
+        }
+        impl->lock_fd = TakeWriterLock(dir);
+        impl->writer = true;
+        impl->db = std::make_unique<Database>(catalog, Database::Mode::kReadWrite);
+        impl->db->Exec("PRAGMA synchronous = FULL");
+        detail::MigrateCatalog(*impl->db);
+    } else {
+        impl->db = std::make_unique<Database>(catalog, Database::Mode::kReadOnly);
+        detail::RequireReadableVersion(*impl->db);
+    }
+    impl->settings = detail::ReadSettings(*impl->db);
+    return MapStore(std::move(impl));
+}
+
+const fs::path& MapStore::dir() const { return impl_->dir; }
+const MapSettings& MapStore::settings() const { return impl_->settings; }
+bool MapStore::writable() const { return impl_->writer; }
+
+Snapshot MapStore::Latest() const { return impl_->SnapshotAt(0); }
+
+Snapshot MapStore::AsOf(int64_t session_id) const {
+    for (const auto& [session, removed] : SessionHistory()) {
+        if (session.id == session_id) return impl_->SnapshotAt(session.commit);
+    }
+    throw std::runtime_error(impl_->dir.string() + ": no session " + std::to_string(session_id));
+}
+
+int64_t MapStore::FindSession(const std::string& id_or_name) const {
+    const auto history = SessionHistory();
+    const bool numeric = !id_or_name.empty() &&
+                         std::all_of(id_or_name.begin(), id_or_name.end(),
+                                     [](char c) { return c >= '0' && c <= '9'; });
+    // Names may repeat: the newest live session with the name wins, then the newest removed one.
+    for (const bool want_alive : {true, false}) {
+        for (auto it = history.rbegin(); it != history.rend(); ++it) {
+            const bool alive = it->second == 0;
+            if (alive != want_alive) continue;
+            if ((numeric && std::to_string(it->first.id) == id_or_name) ||
+                it->first.name == id_or_name) {
+                return it->first.id;
+            }
+        }
+    }
+    std::string known;
+    for (const auto& [s, removed] : history) {
+        known += (known.empty() ? "" : ", ") + std::to_string(s.id) + " " + s.name;
+    }
+    throw std::runtime_error(impl_->dir.string() + ": no session '" + id_or_name +
+                             "' (sessions: " + (known.empty() ? "none" : known) + ")");
+}
+
+std::vector<std::pair<SessionRecord, int64_t>> MapStore::SessionHistory() const {
+    return detail::ReadSessionHistory(*impl_->db);
+}
+
+std::vector<ScanRecord> MapStore::Scans(int64_t session_id) const {
+    return detail::ReadScans(*impl_->db, session_id);
+}
+
+size_t MapStore::TileFileCount() const {
+    detail::Statement q(*impl_->db, "SELECT count(*) FROM tile_versions WHERE file IS NOT NULL");
+    return q.Step() ? static_cast<size_t>(q.Int(0)) : 0;
+}
+
+Tile MapStore::ReadTile(const TileVersion& version) const {
+    const fs::path path = impl_->dir / version.file;
+    return detail::DecodeTile(detail::ReadVerifiedFile(path, version.bytes, version.checksum),
+                              version.key, path);
+}
+
+core::VoxelMap MapStore::EmptyMap() const {
+    return core::VoxelMap::Create(impl_->settings.voxel_size_m, impl_->settings.origin);
+}
+
+core::VoxelMap MapStore::LoadMap(const Snapshot& snapshot) const {
+    std::vector<Tile> tiles(snapshot.tiles.size());
+    tbb::parallel_for(size_t{0}, tiles.size(),
+                      [&](size_t i) { tiles[i] = ReadTile(snapshot.tiles[i]); });
+    core::VoxelMap map = EmptyMap();
+    for (Tile& tile : tiles) detail::MergeMap(map, tile.fused);
+    return map;
+}
+
+CheckReport MapStore::Check() const {
+    CheckReport report;
+    {
+        detail::Statement q(*impl_->db, "PRAGMA quick_check");
+        while (q.Step()) {
+            if (q.Text(0) != "ok") report.problems.push_back({kCatalog, q.Text(0)});
+        }
+    }
+    const std::vector<TileVersion> versions = detail::ReadAllTileVersions(*impl_->db);
+    std::set<std::string> referenced;
+    std::vector<const TileVersion*> files;
+    for (const TileVersion& v : versions) {
+        if (v.file.empty()) continue;
+        referenced.insert(v.file);
+        files.push_back(&v);
+    }
+    report.tile_versions = files.size();
+    std::mutex mutex;
+    tbb::parallel_for(size_t{0}, files.size(), [&](size_t i) {
+        try {
+            (void)ReadTile(*files[i]);
+        } catch (const std::exception& e) {
+            std::lock_guard<std::mutex> lock(mutex);
+            report.problems.push_back({files[i]->file, e.what()});
+        }
+    });
+    std::sort(report.problems.begin(), report.problems.end(),
+              [](const CheckProblem& a, const CheckProblem& b) { return a.file < b.file; });
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(impl_->dir / "tiles", ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        if (!it->is_regular_file()) continue;
+        const std::string rel = fs::relative(it->path(), impl_->dir).generic_string();
+        if (!referenced.count(rel)) report.unreferenced.push_back(rel);
+    }
+    std::sort(report.unreferenced.begin(), report.unreferenced.end());
+    return report;
+}
+
+GcReport MapStore::CollectGarbage() {
+    impl_->RequireWriter("gc");
+    GcReport report;
+    for (const std::string& rel : Check().unreferenced) {
+        const fs::path path = impl_->dir / rel;
+        std::error_code ec;
+        const auto size = fs::file_size(path, ec);
+        if (fs::remove(path, ec)) {
+            report.removed.push_back(rel);
+            report.bytes += ec ? 0 : size;
+        }
+    }
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(impl_->dir / "tiles", ec);
+         !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        std::error_code ignored;
+        if (it->is_directory() && fs::is_empty(it->path(), ignored)) fs::remove(it->path(), ignored);
+    }
+    return report;
+}
+
+int64_t MapStore::RemoveSession(int64_t session_id) {
+    impl_->RequireWriter("session rm");
+    const Impl& impl = *impl_;
+    const Snapshot latest = Latest();
+    const auto victim =
+        std::find_if(latest.sessions.begin(), latest.sessions.end(),
+                     [&](const SessionRecord& s) { return s.id == session_id; });
+    if (victim == latest.sessions.end()) {
+        throw std::runtime_error(impl.dir.string() + ": session " + std::to_string(session_id) +
+                                 " is not in the map (removed already, or never added)");
+    }
+    // The tiles the session touched are the ones its commit wrote.
+    std::set<TileKey> touched;
+    for (const TileVersion& v : detail::ReadAllTileVersions(*impl.db)) {
+        if (v.commit == victim->commit) touched.insert(v.key);
+    }
+    const integration::IntegrationConfig defaults;
+    const float hit = core::LogOdds(defaults.prob_hit);
+    const float miss = core::LogOdds(defaults.prob_miss);
+    const float lo = core::LogOdds(defaults.clamp_min_prob);
+    const float hi = core::LogOdds(defaults.clamp_max_prob);
+    const auto last = detail::ReadLastVersions(*impl.db);
+
+    std::vector<TileVersion> written;
+    std::set<fs::path> dirs;
+    for (const TileVersion& current : latest.tiles) {
+        if (!touched.count(current.key)) continue;
+        Tile tile = ReadTile(current);
+        const auto layer = std::find_if(tile.layers.begin(), tile.layers.end(),
+                                        [&](const SessionLayer& l) { return l.session == session_id; });
+        if (layer == tile.layers.end()) continue;
+        const SessionLayer removed = *layer;
+        tile.layers.erase(layer);
+        // Voxels the removed session never saw keep their values: it contributed nothing there.
+        // Where it did, occupancy is rebuilt from the remaining layers, one vote per session in
+        // session order; label, weight and hits stay only where the voxel is still occupied.
+        openvdb::BoolTree seen(removed.occupied->tree());
+        seen.topologyUnion(removed.free->tree());
+        std::vector<openvdb::BoolGrid::ConstAccessor> occupied, free;
+        for (const SessionLayer& l : tile.layers) {
+            occupied.push_back(l.occupied->getConstAccessor());
+            free.push_back(l.free->getConstAccessor());
+        }
+        auto occupancy = tile.fused.occupancy->getAccessor();
+        auto label = tile.fused.label->getAccessor();
+        auto weight = tile.fused.label_weight->getAccessor();
+        auto hits = tile.fused.hits->getAccessor();
+        for (auto it = seen.cbeginValueOn(); it; ++it) {
+            const openvdb::Coord ijk = it.getCoord();
+            float value = 0.0f;
+            bool observed = false;
+            for (size_t k = 0; k < occupied.size(); ++k) {
+                if (occupied[k].isValueOn(ijk)) {
+                    value = std::clamp(value + hit, lo, hi);
+                    observed = true;
+                } else if (free[k].isValueOn(ijk)) {
+                    value = std::clamp(value + miss, lo, hi);
+                    observed = true;
+                }
+            }
+            if (observed) {
+                occupancy.setValueOn(ijk, value);
+            } else {
+                occupancy.setValueOff(ijk, 0.0f);
+            }
+            if (!observed || value <= 0.0f) {
+                label.setValueOff(ijk, 0);
+                weight.setValueOff(ijk, 0.0f);
+                hits.setValueOff(ijk, 0);
+            }
+        }
+        TileVersion v;
+        v.key = tile.key;
+        v.version = last.at(tile.key) + 1;
+        if (tile.fused.occupancy->activeVoxelCount() > 0 || !tile.layers.empty() ||
+            !tile.products.empty()) {
+            const detail::EncodedTile encoded = detail::EncodeTile(tile);
+            v.file = impl.TileFile(tile.key, v.version);
+            detail::WriteTileFile(impl.dir / v.file, encoded.bytes);
+            v.bytes = encoded.bytes.size();
+            v.checksum = encoded.checksum;
+            dirs.insert(impl.TileDir(tile.key));
+        }
+        written.push_back(v);
+    }
+    for (const fs::path& d : dirs) detail::SyncDirectory(d);
+    Transaction tx(*impl.db, Transaction::Kind::kWrite);
+    const int64_t commit = detail::InsertCommit(*impl.db, "remove_session", session_id);
+    for (TileVersion& v : written) {
+        v.commit = commit;
+        detail::InsertTileVersion(*impl.db, v);
+    }
+    detail::MarkSessionRemoved(*impl.db, session_id, commit);
+    tx.Commit();
+    return commit;
+}
+
+}  // namespace strata::store

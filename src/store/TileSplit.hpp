@@ -1,0 +1,51 @@
+#pragma once
+// Private to the store: moving leaves between one big working grid and per-tile grids. Tile edges
+// are multiples of the 8-voxel leaf, so a leaf always belongs to exactly one tile.
+
+#include <map>
+#include <set>
+
+#include "strata/store/MapStore.hpp"
+
+namespace strata::store::detail {
+
+/// Moves every leaf of `from` that lies in one of `keys` (every leaf when `keys` is null) into a
+/// grid per tile, which shares `from`'s transform and metadata. Active tiles above leaf level
+/// must not exist (VoxelizeTiles).
+template <typename GridT>
+std::map<TileKey, typename GridT::Ptr> StealTiles(GridT& from, const MapSettings& settings,
+                                                   const std::set<TileKey>* keys) {
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    std::vector<std::pair<TileKey, openvdb::Coord>> leaves;
+    for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {
+        const TileKey key = settings.TileOf(leaf->origin());
+        if (!keys || keys->count(key)) leaves.emplace_back(key, leaf->origin());
+    }
+    std::map<TileKey, typename GridT::Ptr> out;
+    if (keys) {
+        for (const TileKey& key : *keys) out[key] = from.copyWithNewTree();
+    }
+    const auto background = from.background();
+    for (const auto& [key, origin] : leaves) {
+        auto& grid = out[key];
+        if (!grid) grid = from.copyWithNewTree();
+        grid->tree().addLeaf(
+            from.tree().template stealNode<LeafT>(origin, background, false));
+    }
+    return out;
+}
+
+/// Moves every leaf of `from` into `into` (their leaves must not overlap).
+template <typename GridT>
+void MergeLeaves(GridT& into, GridT& from) {
+    from.tree().voxelizeActiveTiles();
+    into.tree().merge(from.tree(), openvdb::MERGE_NODES);
+}
+
+/// Splits the fused grids of a working map into per-tile maps (every grid present per tile).
+std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapSettings& settings,
+                                                const std::set<TileKey>* keys);
+/// Moves a tile's fused grids into a working map.
+void MergeMap(core::VoxelMap& into, core::VoxelMap& tile);
+
+}  // namespace strata::store::detail
