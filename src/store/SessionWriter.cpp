@@ -295,8 +295,7 @@ SessionWriter::~SessionWriter() {
 int64_t SessionWriter::session_id() const { return state_->session_id; }
 const WriterStats& SessionWriter::stats() const { return state_->stats; }
 
-integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan, double time_s,
-                                                 const std::string& source) {
+integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
     State& s = *state_;
     if (s.done) throw std::logic_error("the session is committed already");
     core::Scan aligned = scan;
@@ -314,10 +313,10 @@ integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan, double 
     }
     ScanRecord record;
     record.index = s.scans.size();
-    record.time_s = time_s;
+    record.time_s = scan.time_s;
     record.pose = scan.T_world_sensor;
     record.points = update.points - update.dropped;
-    record.source = source;
+    record.source = scan.source;
     s.scans.push_back(record);
     s.points += record.points;
     s.Evict(keys);

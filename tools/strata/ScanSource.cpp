@@ -70,18 +70,10 @@ std::string ScanSource::Describe() const {
     return files_.empty() ? std::string() : files_.front().string();
 }
 
-std::string ScanSource::FileOf(size_t i) const {
-    return (kitti_ ? kitti_->scan_files.at(indices_.at(i)) : files_.at(i)).string();
-}
-
-double ScanSource::TimeOf(size_t i) const {
-    return kitti_ && indices_.at(i) < kitti_->times_s.size() ? kitti_->times_s[indices_[i]] : 0.0;
-}
-
 void IntegrateScans(store::SessionWriter& writer, const ScanSource& source) {
     Progress progress("integrating", source.size());
     for (size_t i = 0; i < source.size(); ++i) {
-        (void)writer.Integrate(source.Read(i), source.TimeOf(i), source.FileOf(i));
+        (void)writer.Integrate(source.Read(i));
         progress.Advance();
     }
 }

@@ -24,9 +24,6 @@ public:
 
     [[nodiscard]] size_t size() const { return indices_.size(); }
     [[nodiscard]] core::Scan Read(size_t i) const;
-    /// The file scan `i` comes from and its time in seconds (0 when unknown).
-    [[nodiscard]] std::string FileOf(size_t i) const;
-    [[nodiscard]] double TimeOf(size_t i) const;
     [[nodiscard]] std::string Describe() const;
 
 private:

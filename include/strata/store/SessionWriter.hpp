@@ -55,9 +55,8 @@ public:
     SessionWriter(const SessionWriter&) = delete;
     SessionWriter& operator=(const SessionWriter&) = delete;
 
-    /// Integrates one scan (and records it with `time_s` and `source` in the session's scans).
-    integration::ScanUpdate Integrate(const core::Scan& scan, double time_s = 0.0,
-                                      const std::string& source = {});
+    /// Integrates one scan (and records its pose, time and source file in the session's scans).
+    integration::ScanUpdate Integrate(const core::Scan& scan);
     /// Writes and records the session; the writer cannot be used afterwards.
     SessionRecord Commit();
 

@@ -1,0 +1,441 @@
+// The store: commits, snapshots, session layers, eviction, removal, locking and damaged files,
+// on synthetic scans whose in-memory integration is the known answer.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+
+#include "strata/integration/Integrator.hpp"
+#include "strata/store/MapStore.hpp"
+#include "strata/store/SessionWriter.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using strata::core::Scan;
+using strata::core::VoxelMap;
+using strata::integration::IntegrationConfig;
+using strata::store::MapStore;
+using strata::store::SessionOptions;
+using strata::store::SessionWriter;
+using strata::store::StoreSettings;
+
+constexpr double kVoxel = 0.1;
+constexpr double kTile = 3.2;  // 32 voxels: a 12 m room spans many tiles
+
+fs::path Temp(const std::string& name) {
+    const fs::path p = fs::temp_directory_path() / ("strata_store_" + name);
+    fs::remove_all(p);
+    return p;
+}
+
+// A 12 x 8 x 3 m room around `centre`, with labelled points (floor road, the rest building).
+Scan RoomScan(uint32_t seed, const Eigen::Vector3d& centre, size_t n = 6000) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Scan scan;
+    scan.T_world_sensor.translation() = centre;
+    for (size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d d(u(rng), u(rng), u(rng));
+        const Eigen::Array3d half(6.0, 4.0, 1.5);
+        const double t = (half / d.array().abs()).minCoeff();
+        scan.points.push_back(d * t);
+        scan.labels.push_back(std::abs(d.z() * t + 1.5) < 1e-9 ? strata::core::SemanticClass::kGround
+                                                                : strata::core::SemanticClass::kBuilding);
+    }
+    scan.source = "room_" + std::to_string(seed);
+    scan.time_s = seed * 0.1;
+    return scan;
+}
+
+std::vector<Scan> Session(uint32_t first_seed, const Eigen::Vector3d& start, size_t scans = 3) {
+    std::vector<Scan> out;
+    for (size_t k = 0; k < scans; ++k) {
+        out.push_back(RoomScan(first_seed + static_cast<uint32_t>(k),
+                               start + Eigen::Vector3d(0.7 * static_cast<double>(k), 0.3, 0.1)));
+    }
+    return out;
+}
+
+SessionOptions Named(const std::string& name) {
+    SessionOptions options;
+    options.name = name;
+    return options;
+}
+
+MapStore NewMap(const fs::path& dir) {
+    StoreSettings settings;
+    settings.voxel_size_m = kVoxel;
+    settings.tile_size_m = kTile;
+    return MapStore::Create(dir, settings);
+}
+
+strata::store::SessionRecord Write(MapStore& map, const std::vector<Scan>& scans,
+                                   SessionOptions options = {}) {
+    SessionWriter writer(map, IntegrationConfig{}, std::move(options));
+    for (const Scan& scan : scans) (void)writer.Integrate(scan);
+    return writer.Commit();
+}
+
+// The reference: the same scans integrated into one in-memory map.
+VoxelMap InMemory(const std::vector<std::vector<Scan>>& sessions) {
+    VoxelMap map = VoxelMap::Create(kVoxel);
+    strata::integration::Integrator integrator(map, IntegrationConfig{});
+    for (const auto& scans : sessions) {
+        for (const Scan& scan : scans) (void)integrator.Integrate(scan);
+    }
+    return map;
+}
+
+// Exact equality of two grids: same active voxels, same values.
+template <typename GridT>
+::testing::AssertionResult SameGrid(const GridT& a, const GridT& b) {
+    if (a.activeVoxelCount() != b.activeVoxelCount()) {
+        return ::testing::AssertionFailure() << a.getName() << ": " << a.activeVoxelCount()
+                                             << " vs " << b.activeVoxelCount() << " voxels";
+    }
+    auto acc = b.getConstAccessor();
+    for (auto it = a.cbeginValueOn(); it; ++it) {
+        typename GridT::ValueType v{};
+        if (!acc.probeValue(it.getCoord(), v) || v != *it) {
+            return ::testing::AssertionFailure() << a.getName() << " differs at " << it.getCoord()
+                                                 << ": " << *it << " vs " << v << " (on "
+                                                 << acc.isValueOn(it.getCoord()) << ")";
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+void ExpectSameMap(const VoxelMap& a, const VoxelMap& b) {
+    EXPECT_TRUE(SameGrid(*a.occupancy, *b.occupancy));
+    EXPECT_TRUE(SameGrid(*a.label, *b.label));
+    EXPECT_TRUE(SameGrid(*a.label_weight, *b.label_weight));
+    EXPECT_TRUE(SameGrid(*a.hits, *b.hits));
+}
+
+::testing::AssertionResult ThrowsNaming(const std::function<void()>& fn, const std::string& what) {
+    try {
+        fn();
+    } catch (const std::exception& e) {
+        if (std::string(e.what()).find(what) != std::string::npos) {
+            return ::testing::AssertionSuccess();
+        }
+        return ::testing::AssertionFailure() << "message '" << e.what() << "' lacks '" << what << "'";
+    }
+    return ::testing::AssertionFailure() << "no exception";
+}
+
+TEST(Store, CreateRecordsSettingsAndRefusesToOverwrite) {
+    const fs::path dir = Temp("create");
+    StoreSettings settings;
+    settings.voxel_size_m = 0.15;
+    settings.tile_size_m = 64.0;
+    settings.origin = Eigen::Vector3d(500000.0, 4000000.0, 30.0);
+    { (void)MapStore::Create(dir, settings); }
+    const MapStore map = MapStore::Open(dir, MapStore::Access::kRead);
+    EXPECT_DOUBLE_EQ(map.settings().voxel_size_m, 0.15);
+    // 64 m / 0.15 m = 426.7 voxels, rounded to whole 8-voxel leaves: 53 leaves.
+    EXPECT_EQ(map.settings().tile_voxels, 424);
+    EXPECT_EQ(map.settings().origin, settings.origin);
+    EXPECT_EQ(map.settings().format_version, MapStore::kFormatVersion);
+    EXPECT_EQ(map.Latest().sessions.size(), 0u);
+    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Create(dir, settings); }, dir.string()));
+    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(Temp("nothing"), MapStore::Access::kRead); },
+                             "no such map directory"));
+    const fs::path empty = Temp("empty");
+    fs::create_directories(empty);
+    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(empty, MapStore::Access::kRead); },
+                             "not a strata map"));
+}
+
+TEST(Store, TileKeysFloorNegativeCoordinates) {
+    strata::store::MapSettings s;
+    s.tile_voxels = 32;
+    EXPECT_EQ(s.TileOf({0, 31, 5}), (strata::store::TileKey{0, 0}));
+    EXPECT_EQ(s.TileOf({-1, 32, 5}), (strata::store::TileKey{-1, 1}));
+    EXPECT_EQ(s.TileOf({-32, -33, 5}), (strata::store::TileKey{-1, -2}));
+    EXPECT_TRUE(s.TileBounds({-1, 1}).isInside(openvdb::Coord(-1, 32, -100000)));
+}
+
+TEST(Store, SessionsEqualInMemoryIntegrationAndSnapshotsGoBack) {
+    const fs::path dir = Temp("sessions");
+    const auto first = Session(1, {0, 0, 0});
+    const auto second = Session(10, {4.0, 1.0, 0.0});
+    {
+        MapStore map = NewMap(dir);
+        const auto s1 = Write(map, first, Named("first"));
+        const auto s2 = Write(map, second, Named("second"));
+        EXPECT_EQ(s1.id, 1);
+        EXPECT_EQ(s2.id, 2);
+        EXPECT_EQ(s2.scans, 3u);
+    }
+    const MapStore map = MapStore::Open(dir, MapStore::Access::kRead);
+    const auto latest = map.Latest();
+    ASSERT_EQ(latest.sessions.size(), 2u);
+    EXPECT_EQ(latest.sessions[1].name, "second");
+    EXPECT_GT(latest.tiles.size(), 8u);  // the rooms span many 3.2 m tiles
+    {
+        SCOPED_TRACE("latest");
+        ExpectSameMap(map.LoadMap(latest), InMemory({first, second}));
+    }
+    {
+        SCOPED_TRACE("as of session 1");
+        ExpectSameMap(map.LoadMap(map.AsOf(1)), InMemory({first}));
+    }
+    EXPECT_EQ(map.AsOf(1).sessions.size(), 1u);
+    EXPECT_EQ(map.FindSession("second"), 2);
+    EXPECT_EQ(map.FindSession("1"), 1);
+    EXPECT_TRUE(ThrowsNaming([&] { (void)map.FindSession("nope"); }, "no session 'nope'"));
+    const auto scans = map.Scans(2);
+    ASSERT_EQ(scans.size(), 3u);
+    EXPECT_EQ(scans[1].source, "room_11");
+    EXPECT_TRUE(scans[2].pose.isApprox(second[2].T_world_sensor, 1e-12));
+    EXPECT_TRUE(map.Check().ok());
+}
+
+TEST(Store, UntouchedTilesAreNotRewritten) {
+    const fs::path dir = Temp("untouched");
+    MapStore map = NewMap(dir);
+    (void)Write(map, Session(1, {0, 0, 0}));
+    const auto before = map.Latest();
+    // A small scan far inside one tile: only the tiles its rays cross get new versions.
+    Scan small;
+    small.T_world_sensor.translation() = Eigen::Vector3d(1.65, 1.65, 0.05);
+    small.points = {{0.5, 0.0, 0.0}, {0.0, 0.5, 0.0}};
+    (void)Write(map, {small});
+    const auto after = map.Latest();
+    ASSERT_EQ(after.tiles.size(), before.tiles.size());
+    size_t rewritten = 0;
+    for (size_t i = 0; i < after.tiles.size(); ++i) {
+        if (after.tiles[i].version != before.tiles[i].version) {
+            ++rewritten;
+            EXPECT_EQ(after.tiles[i].key, (strata::store::TileKey{0, 0}));
+        } else {
+            EXPECT_EQ(after.tiles[i].file, before.tiles[i].file);
+        }
+    }
+    EXPECT_EQ(rewritten, 1u);
+}
+
+TEST(Store, SessionLayersSayWhatEachSessionSaw) {
+    const fs::path dir = Temp("layers");
+    MapStore map = NewMap(dir);
+    const auto first = Session(1, {0, 0, 0});
+    (void)Write(map, first);
+    (void)Write(map, Session(10, {4.0, 1.0, 0.0}));
+    const VoxelMap only_first = InMemory({first});
+    size_t occupied = 0;
+    for (const auto& version : map.Latest().tiles) {
+        const strata::store::Tile tile = map.ReadTile(version);
+        ASSERT_FALSE(tile.layers.empty());
+        for (const auto& layer : tile.layers) {
+            EXPECT_EQ(layer.occupied->getName(), "session_" + std::to_string(layer.session) +
+                                                     "_occupied");
+            // Disjoint, and inside what the fused map observed.
+            auto free = layer.free->getConstAccessor();
+            auto fused = tile.fused.occupancy->getConstAccessor();
+            for (auto it = layer.occupied->cbeginValueOn(); it; ++it) {
+                EXPECT_FALSE(free.isValueOn(it.getCoord()));
+                EXPECT_TRUE(fused.isValueOn(it.getCoord()));
+            }
+        }
+        // Session 1's layers are its own integration, thresholded.
+        if (tile.layers.front().session != 1) continue;
+        auto ref = only_first.occupancy->getConstAccessor();
+        for (auto it = tile.layers.front().occupied->cbeginValueOn(); it; ++it) {
+            EXPECT_GT(ref.getValue(it.getCoord()), 0.0f);
+            ++occupied;
+        }
+        for (auto it = tile.layers.front().free->cbeginValueOn(); it; ++it) {
+            EXPECT_TRUE(ref.isValueOn(it.getCoord()));
+            EXPECT_LE(ref.getValue(it.getCoord()), 0.0f);
+        }
+    }
+    size_t expected = 0;
+    for (auto it = only_first.occupancy->cbeginValueOn(); it; ++it) expected += *it > 0.0f;
+    EXPECT_EQ(occupied, expected);
+}
+
+TEST(Store, MemoryBudgetEvictsTilesAndGivesTheSameMap) {
+    // Rooms 15 m apart (each 12 m wide): the session walks away from its first tiles and comes
+    // back, so tiles are evicted, read back from their pending versions and written again.
+    std::vector<Scan> walk;
+    for (const double x : {0.0, 15.0, 30.0, 15.0, 0.0}) {
+        walk.push_back(RoomScan(static_cast<uint32_t>(walk.size() + 40), {x, 0.2, 0.1}));
+    }
+    const auto first = Session(1, {0, 0, 0});
+    const fs::path dir = Temp("budget");
+    MapStore map = NewMap(dir);
+    (void)Write(map, first);
+    SessionOptions tight;
+    tight.memory_budget_bytes = 2'000'000;  // about one room's tiles
+    SessionWriter writer(map, IntegrationConfig{}, tight);
+    for (const Scan& scan : walk) (void)writer.Integrate(scan);
+    EXPECT_GT(writer.stats().tiles_evicted, 10u);
+    EXPECT_GT(writer.stats().tiles_loaded, writer.stats().tiles_evicted / 2);
+    (void)writer.Commit();
+    ExpectSameMap(map.LoadMap(map.Latest()), InMemory({first, walk}));
+    // Evictions wrote pending files that the commit kept or superseded: nothing is left over.
+    const auto report = map.Check();
+    EXPECT_TRUE(report.ok());
+    EXPECT_TRUE(report.unreferenced.empty()) << report.unreferenced.front();
+}
+
+TEST(Store, RemovingASessionRebuildsOnlyWhatItSaw) {
+    const fs::path dir = Temp("remove");
+    MapStore map = NewMap(dir);
+    const auto first = Session(1, {0, 0, 0});
+    const auto second = Session(10, {9.0, 0.0, 0.0});  // a room further along: partly new space
+    (void)Write(map, first);
+    (void)Write(map, second);
+    const VoxelMap before = map.LoadMap(map.Latest());
+    (void)map.RemoveSession(2);
+    const auto latest = map.Latest();
+    ASSERT_EQ(latest.sessions.size(), 1u);
+    const VoxelMap after = map.LoadMap(latest);
+    const VoxelMap only_first = InMemory({first});
+    const VoxelMap only_second = InMemory({second});
+    auto first_acc = only_first.occupancy->getConstAccessor();
+    auto second_acc = only_second.occupancy->getConstAccessor();
+    auto after_acc = after.occupancy->getConstAccessor();
+    size_t kept = 0, forgotten = 0;
+    for (auto it = before.occupancy->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord ijk = it.getCoord();
+        const bool seen1 = first_acc.isValueOn(ijk), seen2 = second_acc.isValueOn(ijk);
+        if (!seen2) {  // untouched by the removed session: bit-identical
+            EXPECT_EQ(after_acc.getValue(ijk), *it);
+            ++kept;
+        } else if (!seen1) {  // only the removed session saw it: unknown again
+            EXPECT_FALSE(after_acc.isValueOn(ijk));
+            ++forgotten;
+        } else {  // both: one vote of session 1, same sign as session 1's own evidence
+            ASSERT_TRUE(after_acc.isValueOn(ijk));
+            EXPECT_EQ(after_acc.getValue(ijk) > 0.0f, first_acc.getValue(ijk) > 0.0f);
+        }
+    }
+    EXPECT_GT(kept, 1000u);
+    EXPECT_GT(forgotten, 1000u);
+    for (const auto& version : latest.tiles) {
+        for (const auto& layer : map.ReadTile(version).layers) EXPECT_EQ(layer.session, 1);
+    }
+    // History still holds the session.
+    ExpectSameMap(map.LoadMap(map.AsOf(2)), before);
+    EXPECT_TRUE(ThrowsNaming([&] { (void)map.RemoveSession(2); }, "not in the map"));
+    // Removing the last session empties the map.
+    (void)map.RemoveSession(1);
+    EXPECT_TRUE(map.Latest().tiles.empty());
+    EXPECT_EQ(map.LoadMap(map.Latest()).occupancy->activeVoxelCount(), 0u);
+    EXPECT_TRUE(map.Check().ok());
+}
+
+TEST(Store, OneWriterAtATimeAndReadersKeepTheirSnapshot) {
+    const fs::path dir = Temp("lock");
+    MapStore writer = NewMap(dir);
+    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(dir, MapStore::Access::kWrite); },
+                             "another strata process"));
+    (void)Write(writer, Session(1, {0, 0, 0}));
+    MapStore reader = MapStore::Open(dir, MapStore::Access::kRead);
+    const auto snapshot = reader.Latest();
+    const VoxelMap seen = reader.LoadMap(snapshot);
+    (void)Write(writer, Session(10, {2.0, 0.0, 0.0}));
+    // The old snapshot reads the same files, which nobody modified.
+    ExpectSameMap(reader.LoadMap(snapshot), seen);
+    EXPECT_EQ(reader.Latest().sessions.size(), 2u);
+    EXPECT_THROW((void)SessionWriter(reader, IntegrationConfig{}, SessionOptions{}),
+                 std::logic_error);
+    { MapStore released = std::move(writer); }
+    EXPECT_NO_THROW((void)MapStore::Open(dir, MapStore::Access::kWrite));
+}
+
+TEST(Store, AFailedCommitLeavesThePreviousCommitAndNoFiles) {
+    for (const std::string step : {"tiles_written", "tiles_synced", "catalog_written"}) {
+        const fs::path dir = Temp("fault_" + step);
+        MapStore map = NewMap(dir);
+        (void)Write(map, Session(1, {0, 0, 0}));
+        const auto before = map.Latest();
+        const VoxelMap before_map = map.LoadMap(before);
+        SessionOptions options;
+        options.fault_hook = [&](const std::string& at) {
+            if (at == step) throw std::runtime_error("injected failure at " + at);
+        };
+        EXPECT_TRUE(ThrowsNaming([&] { (void)Write(map, Session(10, {2, 0, 0}), options); },
+                                 "injected failure at " + step));
+        const auto after = map.Latest();
+        EXPECT_EQ(after.commit, before.commit) << step;
+        EXPECT_EQ(after.sessions.size(), 1u) << step;
+        ExpectSameMap(map.LoadMap(after), before_map);
+        const auto report = map.Check();
+        EXPECT_TRUE(report.ok()) << step;
+        EXPECT_TRUE(report.unreferenced.empty()) << step;
+        // The next session gets the next id and works.
+        EXPECT_EQ(Write(map, Session(20, {1, 1, 0})).id, 2) << step;
+    }
+}
+
+TEST(Store, DamagedTilesAreNamedAndOthersStillRead) {
+    const fs::path dir = Temp("damaged");
+    MapStore map = NewMap(dir);
+    (void)Write(map, Session(1, {0, 0, 0}));
+    const auto tiles = map.Latest().tiles;
+    ASSERT_GE(tiles.size(), 3u);
+    const fs::path flipped = dir / tiles[0].file;
+    const fs::path cut = dir / tiles[1].file;
+    {
+        std::fstream f(flipped, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(static_cast<std::streamoff>(tiles[0].bytes / 2));
+        f.put('\x5a' ^ static_cast<char>(f.peek()));
+    }
+    fs::resize_file(cut, 8);  // OpenVDB would read a bare header as a valid, empty file
+    EXPECT_TRUE(ThrowsNaming([&] { (void)map.ReadTile(tiles[0]); }, flipped.string()));
+    EXPECT_TRUE(ThrowsNaming([&] { (void)map.ReadTile(tiles[0]); }, "checksum"));
+    EXPECT_TRUE(ThrowsNaming([&] { (void)map.ReadTile(tiles[1]); }, "bytes"));
+    EXPECT_NO_THROW((void)map.ReadTile(tiles[2]));
+    EXPECT_TRUE(ThrowsNaming([&] { (void)map.LoadMap(map.Latest()); }, "tiles/"));
+    fs::remove(dir / tiles[2].file);
+    const auto report = map.Check();
+    std::set<std::string> named;
+    for (const auto& problem : report.problems) named.insert(problem.file);
+    EXPECT_EQ(named, (std::set<std::string>{tiles[0].file, tiles[1].file, tiles[2].file}));
+    EXPECT_EQ(report.problems.size(), 3u);
+}
+
+TEST(Store, NewerFormatsAndForeignFilesAreRefused) {
+    const fs::path dir = Temp("newer");
+    { (void)NewMap(dir); }
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir / "catalog.sqlite").c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 99", nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+    for (const auto access : {MapStore::Access::kRead, MapStore::Access::kWrite}) {
+        EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(dir, access); }, "newer"));
+    }
+    const fs::path garbage = Temp("garbage");
+    fs::create_directories(garbage);
+    std::ofstream(garbage / "catalog.sqlite") << "this is not a database";
+    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(garbage, MapStore::Access::kRead); },
+                             (garbage / "catalog.sqlite").string()));
+}
+
+TEST(Store, ReadOnlyMapsOpenForReadingOnly) {
+    const fs::path dir = Temp("readonly");
+    {
+        MapStore map = NewMap(dir);
+        (void)Write(map, Session(1, {0, 0, 0}));
+    }
+    fs::permissions(dir, fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write,
+                    fs::perm_options::remove);
+    fs::permissions(dir / "catalog.sqlite",
+                    fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write,
+                    fs::perm_options::remove);
+    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(dir, MapStore::Access::kWrite); },
+                             "read-only"));
+    const MapStore map = MapStore::Open(dir, MapStore::Access::kRead);
+    EXPECT_EQ(map.Latest().sessions.size(), 1u);
+    fs::permissions(dir, fs::perms::owner_write, fs::perm_options::add);
+    fs::permissions(dir / "catalog.sqlite", fs::perms::owner_write, fs::perm_options::add);
+}
+
+}  // namespace
