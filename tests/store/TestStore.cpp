@@ -5,7 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <atomic>
 #include <random>
+#include <thread>
 #include <set>
 
 #include "strata/integration/Integrator.hpp"
@@ -348,6 +350,34 @@ TEST(Store, OneWriterAtATimeAndReadersKeepTheirSnapshot) {
                  std::logic_error);
     { MapStore released = std::move(writer); }
     EXPECT_NO_THROW((void)MapStore::Open(dir, MapStore::Access::kWrite));
+}
+
+TEST(Store, ReadersSeeWholeCommitsWhileAWriterCommits) {
+    const fs::path dir = Temp("concurrent");
+    const std::vector<std::vector<Scan>> sessions = {Session(1, {0, 0, 0}, 2),
+                                                     Session(10, {3, 1, 0}, 2),
+                                                     Session(20, {-2, -1, 0}, 2)};
+    std::vector<VoxelMap> expected;  // the map after k sessions
+    for (size_t k = 0; k <= sessions.size(); ++k) {
+        expected.push_back(InMemory({sessions.begin(), sessions.begin() + static_cast<long>(k)}));
+    }
+    MapStore writer = NewMap(dir);
+    std::atomic<bool> done{false};
+    std::vector<size_t> seen;  // session counts the reader observed
+    std::thread reader([&] {
+        const MapStore map = MapStore::Open(dir, MapStore::Access::kRead);
+        while (!done.load()) {
+            const auto snapshot = map.Latest();
+            const size_t n = snapshot.sessions.size();
+            ExpectSameMap(map.LoadMap(snapshot), expected.at(n));
+            seen.push_back(n);
+        }
+    });
+    for (const auto& scans : sessions) (void)Write(writer, scans);
+    done = true;
+    reader.join();
+    ASSERT_FALSE(seen.empty());
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
 }
 
 TEST(Store, AFailedCommitLeavesThePreviousCommitAndNoFiles) {
