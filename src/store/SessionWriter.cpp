@@ -29,8 +29,10 @@ std::string UtcNow() {
     return buf;
 }
 
-// A session's own log-odds over one tile -> its two layers (occupied: > 0, free: <= 0).
+// A session's own log-odds over one tile -> its two layers (occupied: > 0, free: <= 0), built
+// leaf by leaf: a layer voxel is true and active, or false and inactive.
 SessionLayer ToLayer(int64_t session, const openvdb::FloatGrid& logodds) {
+    using BoolLeaf = openvdb::BoolTree::LeafNodeType;
     SessionLayer layer{session, openvdb::BoolGrid::create(false), openvdb::BoolGrid::create(false)};
     for (auto* grid : {layer.occupied.get(), layer.free.get()}) {
         grid->setTransform(logodds.transform().copy());
@@ -38,10 +40,19 @@ SessionLayer ToLayer(int64_t session, const openvdb::FloatGrid& logodds) {
         grid->insertMeta("units", openvdb::StringMetadata("seen by session " +
                                                           std::to_string(session)));
     }
-    auto occupied = layer.occupied->getAccessor();
-    auto free = layer.free->getAccessor();
-    for (auto it = logodds.cbeginValueOn(); it; ++it) {
-        (*it > 0.0f ? occupied : free).setValueOn(it.getCoord(), true);
+    for (auto leaf = logodds.tree().cbeginLeaf(); leaf; ++leaf) {
+        BoolLeaf::NodeMaskType occupied, free;
+        for (auto on = leaf->cbeginValueOn(); on; ++on) {
+            (*on > 0.0f ? occupied : free).setOn(on.pos());
+        }
+        for (auto [grid, mask] : {std::pair{layer.occupied.get(), &occupied},
+                                  std::pair{layer.free.get(), &free}}) {
+            if (mask->isOff()) continue;
+            auto* out = new BoolLeaf(leaf->origin(), false, false);
+            out->buffer() = BoolLeaf::Buffer(*mask);
+            out->setValueMask(*mask);
+            grid->tree().addLeaf(out);
+        }
     }
     return layer;
 }

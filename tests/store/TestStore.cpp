@@ -239,7 +239,9 @@ TEST(Store, SessionLayersSayWhatEachSessionSaw) {
             // Disjoint, and inside what the fused map observed.
             auto free = layer.free->getConstAccessor();
             auto fused = tile.fused.occupancy->getConstAccessor();
+            EXPECT_EQ(layer.occupied->tree().activeTileCount(), 0u);
             for (auto it = layer.occupied->cbeginValueOn(); it; ++it) {
+                EXPECT_TRUE(*it);
                 EXPECT_FALSE(free.isValueOn(it.getCoord()));
                 EXPECT_TRUE(fused.isValueOn(it.getCoord()));
             }
