@@ -32,6 +32,7 @@ using detail::Transaction;
 
 constexpr const char* kCatalog = "catalog.sqlite";
 constexpr const char* kLockFile = "writer.lock";
+constexpr const char* kCreating = ".catalog.sqlite.creating";  // the catalog until it is complete
 constexpr const char* kProducer = "strata 0.1.0";
 
 std::string UtcNow() {
@@ -80,6 +81,29 @@ int TakeWriterLock(const fs::path& dir) {
     return fd;
 }
 
+// What an interrupted Create leaves: the lock file, an empty tiles/, a half-built catalog.
+bool OnlyCreationLeftovers(const fs::path& dir) {
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
+         it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name == kLockFile || name.rfind(kCreating, 0) == 0) continue;
+        std::error_code ignored;
+        if (name == "tiles" && it->is_directory(ignored) && fs::is_empty(it->path(), ignored)) {
+            continue;
+        }
+        return false;
+    }
+    return !ec;
+}
+
+void RemoveCreationLeftovers(const fs::path& dir) {
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
+        std::error_code ignored;
+        fs::remove(dir / (std::string(kCreating) + suffix), ignored);
+    }
+}
+
 void RequireMapDirectory(const fs::path& dir) {
     if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": no such map directory");
     if (fs::exists(dir / kCatalog)) return;
@@ -87,6 +111,11 @@ void RequireMapDirectory(const fs::path& dir) {
         throw std::runtime_error(dir.string() +
                                  ": a single-file map from an earlier strata (map.vdb, no "
                                  "catalog); integrate its scans into a new map");
+    }
+    std::error_code ec;
+    if (!fs::is_empty(dir, ec) && !ec && OnlyCreationLeftovers(dir)) {
+        throw std::runtime_error(dir.string() + ": not a strata map: its creation was interrupted "
+                                 "(run `strata integrate` on it again)");
     }
     throw std::runtime_error(dir.string() + ": not a strata map (no " + kCatalog + ")");
 }
@@ -165,21 +194,29 @@ MapStore MapStore::Create(const fs::path& dir, const StoreSettings& settings) {
     const int32_t tile_voxels = TileVoxels(settings);
     if (!settings.origin.allFinite()) throw std::invalid_argument("map origin must be finite");
     std::error_code ec;
-    if (fs::exists(dir) && !(fs::is_directory(dir) && fs::is_empty(dir, ec))) {
-        throw std::runtime_error(dir.string() + ": exists and is not an empty directory");
+    const bool existed = fs::exists(dir);
+    fs::create_directories(dir, ec);
+    if (ec) throw std::runtime_error(dir.string() + ": cannot create (" + ec.message() + ")");
+    const auto refuse = [&] {
+        throw std::runtime_error(dir.string() + ": exists and is neither empty nor a map whose "
+                                 "creation was interrupted");
+    };
+    if (fs::exists(dir / kCatalog) || !OnlyCreationLeftovers(dir)) refuse();
+    // The catalog is built under a temporary name and renamed last: a directory holds a map
+    // exactly when it holds catalog.sqlite. The lock keeps two creators apart.
+    const int lock = TakeWriterLock(dir);
+    if (fs::exists(dir / kCatalog)) {
+        ::close(lock);
+        refuse();
     }
-    const fs::path parent = fs::absolute(dir).parent_path();
-    fs::create_directories(parent, ec);
-    if (ec) throw std::runtime_error(parent.string() + ": cannot create (" + ec.message() + ")");
-    // Built beside its final place and renamed: a map directory is complete or absent.
-    const fs::path tmp = parent / ("." + fs::absolute(dir).filename().string() + ".creating-" +
-                                   std::to_string(::getpid()));
-    fs::remove_all(tmp, ec);
+    const fs::path building = dir / kCreating;
     try {
-        fs::create_directories(tmp / "tiles");
+        RemoveCreationLeftovers(dir);
+        fs::create_directories(dir / "tiles");
         {
-            Database db(tmp / kCatalog, Database::Mode::kCreate);
+            Database db(building, Database::Mode::kCreate);
             db.Exec("PRAGMA journal_mode = WAL");
+            db.Exec("PRAGMA synchronous = FULL");
             detail::MigrateCatalog(db);
             MapSettings s;
             s.voxel_size_m = settings.voxel_size_m;
@@ -192,29 +229,41 @@ MapStore MapStore::Create(const fs::path& dir, const StoreSettings& settings) {
             detail::WriteSettings(db, s);
             detail::InsertCommit(db, "create", 0);
             tx.Commit();
+        }  // closing the last connection checkpoints the WAL into the file and deletes it
+        if (fs::exists(building.string() + "-wal")) {
+            throw std::runtime_error("SQLite kept a write-ahead log after closing");
         }
-        detail::SyncDirectory(tmp / "tiles");
-        detail::SyncDirectory(tmp);
-        fs::rename(tmp, dir);
-        detail::SyncDirectory(parent);
+        detail::SyncDirectory(dir / "tiles");
+        fs::rename(building, dir / kCatalog);
+        detail::SyncDirectory(dir);
+        detail::SyncDirectory(fs::absolute(dir).parent_path());
     } catch (const std::exception& e) {
-        fs::remove_all(tmp, ec);
+        RemoveCreationLeftovers(dir);
+        ::close(lock);
+        if (!existed) fs::remove_all(dir, ec);
         throw std::runtime_error(dir.string() + ": cannot create the map (" + e.what() + ")");
     }
-    return Open(dir, Access::kWrite);
+    return OpenWithLock(dir, Access::kWrite, lock);
 }
 
 MapStore MapStore::Open(const fs::path& dir, Access access) {
     RequireMapDirectory(dir);
+    if (access == Access::kWrite) {
+        if (!Writable(dir) || !Writable(dir / kCatalog)) {
+            throw std::runtime_error(dir.string() + ": the map is read-only (no write permission)");
+        }
+        return OpenWithLock(dir, access, TakeWriterLock(dir));
+    }
+    return OpenWithLock(dir, access, -1);
+}
+
+MapStore MapStore::OpenWithLock(const fs::path& dir, Access access, int lock_fd) {
     openvdb::initialize();
     auto impl = std::make_unique<Impl>();
     impl->dir = dir;
+    impl->lock_fd = lock_fd;  // owned from here: released with the store, or by the kernel
     const fs::path catalog = dir / kCatalog;
     if (access == Access::kWrite) {
-        if (!Writable(dir) || !Writable(catalog)) {
-            throw std::runtime_error(dir.string() + ": the map is read-only (no write permission)");
-        }
-        impl->lock_fd = TakeWriterLock(dir);
         impl->writer = true;
         impl->db = std::make_unique<Database>(catalog, Database::Mode::kReadWrite);
         impl->db->Exec("PRAGMA synchronous = FULL");

@@ -1,88 +1,26 @@
 // End-to-end tests of the `strata` program: it runs, explains failures, and never damages a map.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <map>
-#include <sstream>
 #include <nlohmann/json.hpp>
-#include <random>
 
-#include "strata/io/KittiSequence.hpp"
-#include "strata/store/MapStore.hpp"
+#include "CliTestUtil.hpp"
 #include "strata/io/PoseFiles.hpp"
+#include "strata/store/MapStore.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-    int code = 0;
-    std::string out;  // stdout and stderr together
-};
-
 using strata::store::MapStore;
+using strata::tools::test::MakeSequence;
+using strata::tools::test::MapFiles;
+using strata::tools::test::Result;
+using strata::tools::test::Strata;
+using strata::tools::test::Temp;
 
 MapStore OpenForReading(const fs::path& map) { return MapStore::Open(map, MapStore::Access::kRead); }
-
-// Every tile file of a map with its bytes: equal before and after means the map is untouched.
-std::map<std::string, std::string> MapFiles(const fs::path& map) {
-    std::map<std::string, std::string> files;
-    for (const auto& e : fs::recursive_directory_iterator(map)) {
-        if (!e.is_regular_file() || e.path().filename() == "writer.lock") continue;
-        if (e.path().filename().string().rfind("catalog.sqlite", 0) == 0) continue;
-        std::ifstream in(e.path(), std::ios::binary);
-        std::ostringstream bytes;
-        bytes << in.rdbuf();
-        files[fs::relative(e.path(), map).string()] = bytes.str();
-    }
-    return files;
-}
-
-Result Strata(const std::string& args) {
-    const std::string cmd = std::string(STRATA_BINARY) + " " + args + " 2>&1";
-    Result r;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf;
-    while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-    const int status = pipe ? ::pclose(pipe) : -1;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
-
-// A tiny KITTI sequence: a 6 x 5 x 3 m room with a box in it, seen from three poses.
-fs::path MakeSequence(const fs::path& dir) {
-    fs::remove_all(dir);
-    fs::create_directories(dir / "velodyne");
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    std::vector<Eigen::Isometry3d> poses;
-    for (int k = 0; k < 3; ++k) {
-        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-        T.translation() = Eigen::Vector3d(0.5 * k + 0.13, 0.07, 0.03);
-        poses.push_back(T);
-        std::vector<Eigen::Vector3d> points;
-        for (int i = 0; i < 4000; ++i) {
-            Eigen::Vector3d d(u(rng), u(rng), u(rng));
-            const double t = (Eigen::Array3d(3.0, 2.5, 1.5) / d.array().abs()).minCoeff();
-            points.push_back(d * t);  // room centred on the sensor, good enough for a test
-        }
-        char name[32];
-        std::snprintf(name, sizeof(name), "%06d.bin", k);
-        strata::io::WriteKittiBin(dir / "velodyne" / name, points);
-    }
-    strata::io::WriteKittiPoses(dir / "poses.txt", poses);
-    return dir;
-}
-
-fs::path Temp(const std::string& name) {
-    const fs::path p = fs::temp_directory_path() / ("strata_cli_" + name);
-    fs::remove_all(p);
-    return p;
-}
 
 TEST(Cli, IntegrateInfoAndExportEndToEnd) {
     const fs::path seq = MakeSequence(Temp("seq"));

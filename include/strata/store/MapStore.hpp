@@ -142,8 +142,9 @@ public:
 
     /// True when `dir` holds a catalog.
     [[nodiscard]] static bool IsMap(const std::filesystem::path& dir);
-    /// Creates an empty map in `dir` (absent or an empty directory) and opens it for writing.
-    /// The directory appears complete or not at all (built beside it, then renamed).
+    /// Creates an empty map in `dir` (absent, empty, or left by an interrupted creation) and
+    /// opens it for writing. The catalog is built under a temporary name and renamed last, so a
+    /// directory holds a map exactly when it holds catalog.sqlite.
     [[nodiscard]] static MapStore Create(const std::filesystem::path& dir,
                                          const StoreSettings& settings);
     /// Opens a map. kWrite takes the writer lock and fails at once, naming the process that holds
@@ -194,6 +195,9 @@ public:
 
 private:
     explicit MapStore(std::unique_ptr<Impl> impl);
+    /// Opens with the writer lock `lock_fd` already held (or -1 for readers).
+    [[nodiscard]] static MapStore OpenWithLock(const std::filesystem::path& dir, Access access,
+                                               int lock_fd);
     std::unique_ptr<Impl> impl_;
 };
 
