@@ -223,9 +223,11 @@ struct SessionWriter::State {
     // the budget; the tiles the current scan touched stay.
     void Evict(const std::set<TileKey>& keep) {
         const size_t budget = options.memory_budget_bytes;
+        // Without a budget the working set only grows: Commit measures its peak once.
+        if (budget == 0) return;
         const size_t bytes = MemoryBytes();
         stats.peak_memory_bytes = std::max(stats.peak_memory_bytes, bytes);
-        if (budget == 0 || bytes <= budget) return;
+        if (bytes <= budget) return;
         // Share of memory per tile, by leaf count.
         std::map<TileKey, size_t> leaves;
         size_t total = 0;
@@ -309,9 +311,14 @@ const WriterStats& SessionWriter::stats() const { return state_->stats; }
 integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
     State& s = *state_;
     if (s.done) throw std::logic_error("the session is committed already");
-    core::Scan aligned = scan;
-    aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
-    integration::ScanUpdate update = integration::ComputeScanUpdate(aligned, s.work, s.config);
+    integration::ScanUpdate update;
+    if (s.options.alignment.isIdentity()) {
+        update = integration::ComputeScanUpdate(scan, s.work, s.config);
+    } else {
+        core::Scan aligned = scan;
+        aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
+        update = integration::ComputeScanUpdate(aligned, s.work, s.config);
+    }
     const std::set<TileKey> keys = s.TouchedTiles(update);
     s.MakeResident(keys);
     tbb::parallel_invoke([&] { integration::ApplyScanUpdate(update, s.work, s.config); },

@@ -113,7 +113,10 @@ openvdb::GridPtrVec DecodeGrids(const std::string& bytes, const TileKey& key,
     openvdb::MetaMap::Ptr meta;
     try {
         std::istringstream is(bytes, std::ios::binary);
-        openvdb::io::Stream stream(is);
+        // Delayed loading copies the stream to a temporary file under /tmp (left behind when the
+        // process is killed) and gave inactive voxels arbitrary values, which the integrator then
+        // added to when it activated them.
+        openvdb::io::Stream stream(is, /*delayLoad=*/false);
         grids = stream.getGrids();
         meta = stream.getMetadata();
     } catch (const std::exception& e) {

@@ -35,22 +35,14 @@ std::map<TileKey, typename GridT::Ptr> StealTiles(GridT& from, const MapSettings
     return out;
 }
 
-/// Moves every leaf of `from` into `into` (their leaves must not overlap), inactive voxels
-/// reset to the background.
+/// Moves every leaf of `from` into `into` (their leaves must not overlap).
 template <typename GridT>
 void MergeLeaves(GridT& into, GridT& from) {
     using LeafT = typename GridT::TreeType::LeafNodeType;
     from.tree().voxelizeActiveTiles();
     std::vector<LeafT*> leaves;
     from.tree().stealNodes(leaves);
-    const auto background = from.background();
-    for (LeafT* leaf : leaves) {
-        // The integrator adds to whatever an inactive voxel holds when it activates it, so
-        // inactive must mean background; leaves read back from a mask-compressed file were seen
-        // holding arbitrary inactive values (hits of 262145 where 1 was expected): reset them.
-        for (auto off = leaf->beginValueOff(); off; ++off) off.setValue(background);
-        into.tree().addLeaf(leaf);
-    }
+    for (LeafT* leaf : leaves) into.tree().addLeaf(leaf);
 }
 
 /// Splits the fused grids of a working map into per-tile maps (every grid present per tile).
