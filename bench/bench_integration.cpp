@@ -6,21 +6,21 @@
 // OctoMap is compiled here without OpenMP, so it runs on one thread, as it does by default.
 #include <tbb/global_control.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "BenchSupport.hpp"
 #include "VoxelSets.hpp"
 #include "strata/integration/Integrator.hpp"
-#include "strata/io/KittiSequence.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
+using strata::bench::Clock;
+using strata::bench::Seconds;
 
 struct WorldScan {
     std::vector<Eigen::Vector3f> points;  // world frame, float as OctoMap stores them
@@ -33,16 +33,10 @@ struct Run {
     strata::testing::VoxelSets sets;
 };
 
-double Seconds(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 std::vector<WorldScan> LoadScans(const fs::path& dir, size_t max_scans, size_t& n_points) {
-    const auto seq = strata::io::OpenKittiSequence(dir);
     std::vector<WorldScan> scans;
     n_points = 0;
-    for (size_t i = 0; i < std::min(max_scans, seq.size()); ++i) {
-        const auto scan = strata::io::ReadKittiScan(seq, i);
+    for (const auto& scan : strata::bench::LoadKittiScans(dir, max_scans)) {
         WorldScan w;
         w.origin = scan.T_world_sensor.translation().cast<float>();
         for (const auto& p : scan.points) w.points.push_back((scan.T_world_sensor * p).cast<float>());

@@ -23,6 +23,24 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
   echo "[integration.md, Speed](integration.md#speed)."
   echo
   "$build/bench/bench_integration" "$root/../shared/data"
+  if [[ -x "$build/bench/bench_store" ]]; then
+    echo
+    echo "## Store"
+    echo
+    echo "\`bench/bench_store\`: BALM (89 scans, voxel 0.2 m, default \`IntegrationConfig\`, all"
+    echo "cores) integrated into one in-memory \`VoxelMap\` with \`Integrator\` vs into a map on"
+    echo "disk with \`store::SessionWriter\` and \`Commit\` (catalog + one file per touched"
+    echo "tile, fsync'd), as one session and as 5 sessions of consecutive scans, with 64 m"
+    echo "(default) and 16 m tiles. Overhead: median over runs of store / in-memory time of"
+    echo "the same run (target: at most +20 %); CPU overhead: the same in process CPU time,"
+    echo "steadier on a shared machine. Then one session under a memory budget of a quarter"
+    echo "of the unbudgeted peak, compared tile by tile with the unbudgeted map. Last, what"
+    echo "a reader pays to open a map, take the newest snapshot and read the tile under the"
+    echo "first scan with all its values (median of 20), for maps of growing size up to 6"
+    echo "copies of BALM side by side. Design and guarantees: [store.md](store.md)."
+    echo
+    "$build/bench/bench_store" "$root/../shared/data"
+  fi
   if [[ -x "$build/bench/bench_sim" ]]; then
     echo
     echo "## Simulator (\`bench/bench_sim\`)"

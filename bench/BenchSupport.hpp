@@ -1,0 +1,37 @@
+#pragma once
+// Shared by the benchmark programs: wall-clock timing and loading a posed sequence up front, so
+// that every benchmark times the same thing (integration, not file reading) and reads the data
+// through strata::io exactly as the tools do.
+
+#include <algorithm>
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <limits>
+#include <vector>
+
+#include "strata/core/Scan.hpp"
+#include "strata/io/KittiSequence.hpp"
+
+namespace strata::bench {
+
+using Clock = std::chrono::steady_clock;
+
+/// Seconds elapsed since `start`.
+inline double Seconds(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The first `max_scans` scans of a KITTI-layout sequence: points in the sensor frame, with
+/// pose, time and source file.
+inline std::vector<core::Scan> LoadKittiScans(
+    const std::filesystem::path& dir, size_t max_scans = std::numeric_limits<size_t>::max()) {
+    const io::KittiSequence seq = io::OpenKittiSequence(dir);
+    std::vector<core::Scan> scans;
+    for (size_t i = 0; i < std::min(max_scans, seq.size()); ++i) {
+        scans.push_back(io::ReadKittiScan(seq, i));
+    }
+    return scans;
+}
+
+}  // namespace strata::bench
