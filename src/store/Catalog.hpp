@@ -46,6 +46,9 @@ void InsertScans(const Database& db, int64_t session_id, const std::vector<ScanR
 [[nodiscard]] std::map<TileKey, int64_t> ReadLastVersions(const Database& db);
 void InsertTileVersion(const Database& db, const TileVersion& version);
 
+/// The current UTC time as the catalog stores times (ISO 8601, seconds).
+[[nodiscard]] std::string UtcNow();
+
 /// 16 hex digits, as the catalog stores checksums.
 [[nodiscard]] std::string ChecksumHex(uint64_t checksum);
 

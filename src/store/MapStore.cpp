@@ -10,7 +10,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <ctime>
 #include <fstream>
 #include <limits>
 #include <mutex>
@@ -34,15 +33,6 @@ constexpr const char* kCatalog = "catalog.sqlite";
 constexpr const char* kLockFile = "writer.lock";
 constexpr const char* kCreating = ".catalog.sqlite.creating";  // the catalog until it is complete
 constexpr const char* kProducer = "strata 0.1.0";
-
-std::string UtcNow() {
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&now, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
-}
 
 int64_t FloorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
@@ -224,7 +214,7 @@ MapStore MapStore::Create(const fs::path& dir, const StoreSettings& settings) {
             s.origin = settings.origin;
             s.format_version = kFormatVersion;
             s.created_by = kProducer;
-            s.created_utc = UtcNow();
+            s.created_utc = detail::UtcNow();
             Transaction tx(db, Transaction::Kind::kWrite);
             detail::WriteSettings(db, s);
             detail::InsertCommit(db, "create", 0);

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <map>
 #include <openvdb/tools/Prune.h>
 #include <set>
@@ -19,15 +18,6 @@ namespace strata::store {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string UtcNow() {
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&now, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
-}
 
 // A session's own log-odds over one tile -> its two layers (occupied: > 0, free: <= 0), built
 // leaf by leaf: a layer voxel is true and active, or false and inactive.
@@ -297,7 +287,7 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
     s.work = store.EmptyMap();
     s.session = openvdb::FloatGrid::create(0.0f);
     s.session->setTransform(s.work.occupancy->transform().copy());
-    s.start_utc = UtcNow();
+    s.start_utc = detail::UtcNow();
     if (s.options.name.empty()) s.options.name = "session_" + std::to_string(s.session_id);
 }
 
@@ -387,7 +377,7 @@ SessionRecord SessionWriter::Commit() {
     record.notes = s.options.notes;
     record.alignment = s.options.alignment;
     record.start_utc = s.start_utc;
-    record.end_utc = UtcNow();
+    record.end_utc = detail::UtcNow();
     record.scans = s.scans.size();
     record.points = s.points;
     {

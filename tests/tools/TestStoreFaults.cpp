@@ -339,8 +339,12 @@ TEST(StoreFaults, KilledMapCreationLeavesNothingHiddenAndRecovers) {
             if (name != "map") leftovers.insert(name + " (" + when + ")");
         }
         if (!is_map && fs::exists(root / "map")) {
-            const Result info = Strata("info " + (root / "map").string());
-            EXPECT_NE(info.out.find("creation was interrupted"), std::string::npos) << info.out;
+            // Killed before it wrote anything, the directory is just empty: nothing to explain.
+            if (!fs::is_empty(root / "map")) {
+                const Result info = Strata("info " + (root / "map").string());
+                EXPECT_NE(info.out.find("creation was interrupted"), std::string::npos)
+                    << when << ": " << info.out;
+            }
             const Result again = Strata(Join(IntegrateArgs(root / "map", seq, 1)));
             EXPECT_EQ(again.code, 0) << when << ": " << again.out;
             EXPECT_TRUE(MapStore::IsMap(root / "map")) << when;
