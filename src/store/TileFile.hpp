@@ -19,14 +19,14 @@ struct EncodedTile {
 
 [[nodiscard]] uint64_t Checksum(const std::string& bytes);
 
-/// Serialises grids tagged with their tile (OpenVDB stream format, Blosc-compressed).
+/// Serialises grids tagged with their tile (OpenVDB stream format, active-mask compression).
 [[nodiscard]] EncodedTile EncodeGrids(const openvdb::GridPtrVec& grids, const TileKey& key);
 /// Parses verified bytes of EncodeGrids; `path` only names the file in errors.
 [[nodiscard]] openvdb::GridPtrVec DecodeGrids(const std::string& bytes, const TileKey& key,
                                               const std::filesystem::path& path);
 
 /// Serialises every grid of a tile (fused grids, session layers, products) with OpenVDB's
-/// stream format, Blosc-compressed.
+/// stream format.
 [[nodiscard]] EncodedTile EncodeTile(const Tile& tile);
 
 /// Writes the bytes to `path` (temporary file, checked stream, fsync, rename).
