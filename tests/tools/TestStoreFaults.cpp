@@ -257,11 +257,11 @@ TEST(StoreFaults, KilledIntegrationsLeaveTheMapOfTheCommittedSessions) {
         }
 
         if (!MapStore::IsMap(map)) {
-            // Killed while creating the map: nothing in its place (see the next test for beside).
+            // Killed while creating the map: no map, at most a directory the next attempt's
+            // integrate completes (the next test covers creation in detail).
             history << " -> no map\n";
             ASSERT_EQ(sessions, 0);
             ASSERT_TRUE(out.killed);
-            ASSERT_FALSE(fs::exists(map));
             continue;
         }
         const Result check = Strata("check " + map.string() + " --json");
