@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "BenchSupport.hpp"
+#include "MapDiff.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/store/MapStore.hpp"
 #include "strata/store/SessionWriter.hpp"
@@ -142,24 +143,8 @@ StoreRun IntegrateIntoStore(const std::vector<Scan>& scans, const fs::path& dir,
     return run;
 }
 
-// Same active voxels with the same values (active tiles compared voxel by voxel).
-template <typename GridT>
-bool SameGrid(const GridT& a, const GridT& b) {
-    if (a.activeVoxelCount() != b.activeVoxelCount()) return false;
-    auto acc = b.getConstAccessor();
-    for (auto it = a.cbeginValueOn(); it; ++it) {
-        openvdb::CoordBBox bbox;
-        it.getBoundingBox(bbox);
-        for (auto ijk = bbox.begin(); ijk; ++ijk) {
-            if (!acc.isValueOn(*ijk) || acc.getValue(*ijk) != *it) return false;
-        }
-    }
-    return true;
-}
-
 bool SameMap(const VoxelMap& a, const VoxelMap& b) {
-    return SameGrid(*a.occupancy, *b.occupancy) && SameGrid(*a.label, *b.label) &&
-           SameGrid(*a.label_weight, *b.label_weight) && SameGrid(*a.hits, *b.hits);
+    return strata::testing::MapDifference(a, b).empty();
 }
 
 // Tile by tile: the same tiles, each with the same fused grids and the same session layers.
@@ -177,8 +162,8 @@ bool SameStore(const fs::path& dir_a, const fs::path& dir_b) {
         for (size_t k = 0; k < ta.layers.size(); ++k) {
             const auto& la = ta.layers[k];
             const auto& lb = tb.layers[k];
-            if (la.session != lb.session || !SameGrid(*la.occupied, *lb.occupied) ||
-                !SameGrid(*la.free, *lb.free)) {
+            if (la.session != lb.session || !strata::testing::FirstDifference("occupied", *la.occupied, *lb.occupied).empty() ||
+                !strata::testing::FirstDifference("free", *la.free, *lb.free).empty()) {
                 return false;
             }
         }

@@ -10,6 +10,7 @@
 #include <thread>
 #include <set>
 
+#include "MapDiff.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/store/MapStore.hpp"
 #include "strata/store/SessionWriter.hpp"
@@ -92,30 +93,8 @@ VoxelMap InMemory(const std::vector<std::vector<Scan>>& sessions) {
     return map;
 }
 
-// Exact equality of two grids: same active voxels, same values.
-template <typename GridT>
-::testing::AssertionResult SameGrid(const GridT& a, const GridT& b) {
-    if (a.activeVoxelCount() != b.activeVoxelCount()) {
-        return ::testing::AssertionFailure() << a.getName() << ": " << a.activeVoxelCount()
-                                             << " vs " << b.activeVoxelCount() << " voxels";
-    }
-    auto acc = b.getConstAccessor();
-    for (auto it = a.cbeginValueOn(); it; ++it) {
-        typename GridT::ValueType v{};
-        if (!acc.probeValue(it.getCoord(), v) || v != *it) {
-            return ::testing::AssertionFailure() << a.getName() << " differs at " << it.getCoord()
-                                                 << ": " << *it << " vs " << v << " (on "
-                                                 << acc.isValueOn(it.getCoord()) << ")";
-        }
-    }
-    return ::testing::AssertionSuccess();
-}
-
 void ExpectSameMap(const VoxelMap& a, const VoxelMap& b) {
-    EXPECT_TRUE(SameGrid(*a.occupancy, *b.occupancy));
-    EXPECT_TRUE(SameGrid(*a.label, *b.label));
-    EXPECT_TRUE(SameGrid(*a.label_weight, *b.label_weight));
-    EXPECT_TRUE(SameGrid(*a.hits, *b.hits));
+    EXPECT_EQ(strata::testing::MapDifference(a, b), "");
 }
 
 ::testing::AssertionResult ThrowsNaming(const std::function<void()>& fn, const std::string& what) {
