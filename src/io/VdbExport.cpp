@@ -106,6 +106,12 @@ void WriteVdb(const core::VoxelMap& map, const std::filesystem::path& path,
     file_meta.insertMeta("origin", openvdb::Vec3DMetadata(openvdb::Vec3d(map.origin.data())));
     file_meta.insertMeta("voxel_size", openvdb::DoubleMetadata(map.voxel_size));
     file_meta.insertMeta("class_legend", openvdb::StringMetadata(core::LegendJson()));
+    WriteGrids(openvdb::GridCPtrVec(grids.begin(), grids.end()), file_meta, path);
+}
+
+void WriteGrids(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& file_meta,
+                const std::filesystem::path& path) {
+    openvdb::initialize();
     // io::Stream into a checked std::ostream: io::File::write reports success on a full disk.
     detail::WriteFileAtomically(
         path, [&](std::ostream& os) { openvdb::io::Stream(os).write(grids, file_meta); });

@@ -13,6 +13,7 @@
 #include "store/MapStoreImpl.hpp"
 #include "store/TileFile.hpp"
 #include "store/TileSplit.hpp"
+#include "strata/core/OccupancyMasks.hpp"
 
 namespace strata::store {
 namespace {
@@ -22,29 +23,13 @@ namespace fs = std::filesystem;
 // A session's own log-odds over one tile -> its two layers (occupied: > 0, free: <= 0), built
 // leaf by leaf: a layer voxel is true and active, or false and inactive.
 SessionLayer ToLayer(int64_t session, const openvdb::FloatGrid& logodds) {
-    using BoolLeaf = openvdb::BoolTree::LeafNodeType;
-    SessionLayer layer{session, openvdb::BoolGrid::create(false), openvdb::BoolGrid::create(false)};
-    for (auto* grid : {layer.occupied.get(), layer.free.get()}) {
-        grid->setTransform(logodds.transform().copy());
+    core::OccupancyMasks masks = core::SplitOccupancy(logodds);
+    for (auto* grid : {masks.occupied.get(), masks.free.get()}) {
         grid->setGridClass(openvdb::GRID_UNKNOWN);
         grid->insertMeta("units", openvdb::StringMetadata("seen by session " +
                                                           std::to_string(session)));
     }
-    for (auto leaf = logodds.tree().cbeginLeaf(); leaf; ++leaf) {
-        BoolLeaf::NodeMaskType occupied, free;
-        for (auto on = leaf->cbeginValueOn(); on; ++on) {
-            (*on > 0.0f ? occupied : free).setOn(on.pos());
-        }
-        for (auto [grid, mask] : {std::pair{layer.occupied.get(), &occupied},
-                                  std::pair{layer.free.get(), &free}}) {
-            if (mask->isOff()) continue;
-            auto* out = new BoolLeaf(leaf->origin(), false, false);
-            out->buffer() = BoolLeaf::Buffer(*mask);
-            out->setValueMask(*mask);
-            grid->tree().addLeaf(out);
-        }
-    }
-    return layer;
+    return SessionLayer{session, std::move(masks.occupied), std::move(masks.free)};
 }
 
 }  // namespace

@@ -32,6 +32,12 @@ inline constexpr const char* kColor = "color";
 void WriteVdb(const core::VoxelMap& map, const std::filesystem::path& path,
               const VdbExportOptions& options = {});
 
+/// @brief Writes `grids` and the file metadata `file_meta` to a .vdb file, all or nothing (as
+/// WriteVdb): for analysis products (change masks, slant grids) that are not a whole map.
+/// @note Throws std::runtime_error naming `path` when the file cannot be written.
+void WriteGrids(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& file_meta,
+                const std::filesystem::path& path);
+
 /// @brief The `density` grid WriteVdb writes: Probability(log-odds) on occupied voxels only.
 [[nodiscard]] openvdb::FloatGrid::Ptr MakeDensityGrid(const core::VoxelMap& map);
 /// @brief The `color` grid WriteVdb writes: ClassColor(label) / 255 on occupied voxels only.
