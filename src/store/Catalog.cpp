@@ -93,6 +93,23 @@ CREATE TABLE change_sets (
   report         TEXT
 );
 )sql",
+    // 1 -> 2: change sets name their sides as text (sessions, snapshots or uncommitted scans).
+    // Version 1 never wrote the table, so it is replaced, not altered.
+    R"sql(
+DROP TABLE change_sets;
+CREATE TABLE change_sets (
+  id             INTEGER PRIMARY KEY AUTOINCREMENT,
+  commit_id      INTEGER NOT NULL REFERENCES commits(id),
+  created_utc    TEXT NOT NULL,
+  from_side      TEXT NOT NULL,
+  to_side        TEXT NOT NULL,
+  added_voxels   INTEGER NOT NULL,
+  removed_voxels INTEGER NOT NULL,
+  unknown_voxels INTEGER NOT NULL,
+  objects        INTEGER NOT NULL,
+  report         TEXT NOT NULL
+);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == MapStore::kFormatVersion, "one migration per format version");

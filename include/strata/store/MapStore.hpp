@@ -118,6 +118,20 @@ struct CheckReport {
     [[nodiscard]] bool ok() const { return problems.empty(); }
 };
 
+/// @brief A change query's result kept in the catalog (`strata diff --save`), to be listed later.
+struct ChangeSetRecord {
+    int64_t id = 0;      ///< chosen by the catalog
+    int64_t commit = 0;  ///< the newest commit when it was saved
+    std::string created_utc;
+    std::string from;  ///< the sides, as the query named them
+    std::string to;
+    size_t added_voxels = 0;
+    size_t removed_voxels = 0;
+    size_t unknown_voxels = 0;
+    size_t objects = 0;
+    std::string report;  ///< the JSON report
+};
+
 struct GcReport {
     std::vector<std::string> removed;
     uint64_t bytes = 0;
@@ -138,7 +152,7 @@ public:
     enum class Access { kRead, kWrite };
 
     /// The newest catalog format this build reads and writes.
-    static constexpr int kFormatVersion = 1;
+    static constexpr int kFormatVersion = 2;
 
     /// True when `dir` holds a catalog.
     [[nodiscard]] static bool IsMap(const std::filesystem::path& dir);
@@ -187,6 +201,11 @@ public:
     /// voxels are rebuilt from the remaining sessions' layers. One commit; returns its id.
     /// Writer only.
     int64_t RemoveSession(int64_t session_id);
+
+    /// Keeps a change set in the catalog; returns its id. Writer only.
+    int64_t SaveChangeSet(const ChangeSetRecord& record);
+    /// Every saved change set, oldest first (none in catalogs older than format 2).
+    [[nodiscard]] std::vector<ChangeSetRecord> ChangeSets() const;
 
     /// @cond internal: used by SessionWriter.
     struct Impl;
