@@ -13,5 +13,6 @@ void RegisterDemo(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
 void RegisterSession(CLI::App& app);
 void RegisterMaintenance(CLI::App& app);
+void RegisterDiff(CLI::App& app);
 
 }  // namespace strata::tools

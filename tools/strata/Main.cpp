@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     strata::tools::RegisterExport(app);
     strata::tools::RegisterSession(app);
     strata::tools::RegisterMaintenance(app);
+    strata::tools::RegisterDiff(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     try {

@@ -1,0 +1,213 @@
+// strata diff: what changed between two sessions, two states of the map, or the map and new scans.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "Commands.hpp"
+#include "MapAccess.hpp"
+#include "ScanSource.hpp"
+#include "strata/change/ChangeReport.hpp"
+#include "strata/change/MapObserver.hpp"
+#include "strata/integration/Integrator.hpp"
+
+namespace strata::tools {
+
+namespace {
+
+struct DiffArgs {
+    std::string map;
+    std::string from;
+    std::string to;
+    std::string to_kitti;
+    std::string frames;
+    std::vector<std::string> to_scans;
+    std::string poses;
+    std::string region;
+    std::string class_name;
+    size_t min_voxels = change::ChangeQuery{}.min_voxels;
+    int gap = change::ChangeQuery{}.gap_voxels;
+    int tolerance = change::ChangeQuery{}.surface_tolerance_voxels;
+    bool json = false;
+    std::string vdb;
+    std::string png;
+    bool save = false;
+    bool list = false;
+};
+
+constexpr const char* kSideHelp =
+    "SESSION (id or name: what that session saw), map (the newest map) or map@SESSION (the map "
+    "right after SESSION)";
+
+// One side of the query, resolved against the map, with the name the report gives it.
+struct Side {
+    change::Observation observation;
+    std::string name;
+};
+
+Side Resolve(const std::string& text, const store::MapStore& map, change::MapObserver& observer) {
+    if (text == "map") return {observer.Map(map.Latest()), "map (newest)"};
+    if (text.rfind("map@", 0) == 0) {
+        const int64_t id = map.FindSession(text.substr(4));
+        return {observer.Map(map.AsOf(id)), "map as of session " + std::to_string(id)};
+    }
+    const int64_t id = map.FindSession(text);
+    return {observer.Session(id), "session " + std::to_string(id)};
+}
+
+// The scans of --to-kitti / --to-scans integrated in memory with the map's voxel size and origin.
+Side ObserveScans(const DiffArgs& args, const store::MapStore& map, core::VoxelMap& scratch) {
+    io::ReadOptions read_options;
+    read_options.origin = map.settings().origin;
+    const ScanSource source =
+        args.to_kitti.empty()
+            ? ScanSource::Files({args.to_scans.begin(), args.to_scans.end()}, args.poses,
+                                read_options)
+            : ScanSource::Kitti(args.to_kitti, args.frames);
+    scratch = map.EmptyMap();
+    integration::Integrator integrator(scratch, integration::IntegrationConfig{});
+    for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
+    return {change::ObserveMap(scratch),
+            "scans " + source.Describe() + " (" + std::to_string(source.size()) + ", uncommitted)"};
+}
+
+void List(const DiffArgs& args) {
+    const store::MapStore map = OpenMap(args.map);
+    const std::vector<store::ChangeSetRecord> sets = map.ChangeSets();
+    if (args.json) {
+        nlohmann::json j = nlohmann::json::array();
+        for (const store::ChangeSetRecord& r : sets) {
+            j.push_back({{"id", r.id}, {"commit", r.commit}, {"created_utc", r.created_utc},
+                         {"from", r.from}, {"to", r.to}, {"added_voxels", r.added_voxels},
+                         {"removed_voxels", r.removed_voxels},
+                         {"unknown_voxels", r.unknown_voxels}, {"objects", r.objects},
+                         {"report", nlohmann::json::parse(r.report)}});
+        }
+        std::cout << j.dump(2) << "\n";
+        return;
+    }
+    if (sets.empty()) std::cout << "no saved change sets (strata diff ... --save keeps one)\n";
+    for (const store::ChangeSetRecord& r : sets) {
+        std::cout << r.id << "  " << r.created_utc << "  " << r.from << " -> " << r.to << ": "
+                  << r.objects << " objects, +" << r.added_voxels << " / -" << r.removed_voxels
+                  << " voxels\n";
+    }
+}
+
+void PrintSummary(const change::ChangeSet& changes, const Side& a, const Side& b) {
+    std::cout << a.name << " -> " << b.name << ": " << changes.objects.size() << " objects; "
+              << changes.added_voxels_total << " voxels added, " << changes.removed_voxels_total
+              << " removed, " << changes.unknown_voxels << " seen by one side only (unknown)\n";
+    std::cout << std::fixed << std::setprecision(2);
+    for (const change::ChangeObject& o : changes.objects) {
+        std::cout << "  " << std::setw(3) << o.id << "  " << std::setw(7)
+                  << change::ChangeKindName(o.kind) << "  " << std::setw(6) << o.voxels
+                  << " voxels  " << o.volume_m3 << " m3  at (" << o.centroid.x() << ", "
+                  << o.centroid.y() << ", " << o.centroid.z() << ")  size "
+                  << o.oriented.size.x() << " x " << o.oriented.size.y() << " x "
+                  << o.oriented.size.z() << " m  " << core::ClassName(o.dominant_class) << "\n";
+    }
+}
+
+void Run(const DiffArgs& args) {
+    if (args.list) return List(args);
+    const bool scans = !args.to_kitti.empty() || !args.to_scans.empty();
+    if (!args.to_kitti.empty() && !args.to_scans.empty()) {
+        throw std::invalid_argument("give at most one of --to-kitti and --to-scans");
+    }
+    if (scans == !args.to.empty()) {
+        throw std::invalid_argument("give exactly one of --to SIDE, --to-kitti SEQ, --to-scans");
+    }
+    if (args.from.empty() && !scans) throw std::invalid_argument("--from SIDE is required");
+    if (args.min_voxels < 1) throw std::invalid_argument("--min-voxels must be at least 1");
+    if (args.gap < 0) throw std::invalid_argument("--gap must be >= 0");
+    if (args.tolerance < 0) throw std::invalid_argument("--tolerance must be >= 0");
+
+    change::ChangeQuery query;
+    if (!args.region.empty()) query.region = core::Region::Parse(args.region);
+    if (!args.class_name.empty()) query.class_filter = core::ClassFromName(args.class_name);
+    query.min_voxels = args.min_voxels;
+    query.gap_voxels = args.gap;
+    query.surface_tolerance_voxels = args.tolerance;
+
+    // --save writes the catalog: open as the writer up front, so a busy map fails before work.
+    store::MapStore map = args.save ? store::MapStore::Open(args.map, store::MapStore::Access::kWrite)
+                                    : OpenMap(args.map);
+    change::MapObserver observer(map, query.region);
+    const Side a = Resolve(args.from.empty() ? "map" : args.from, map, observer);
+    core::VoxelMap scratch;
+    const Side b = scans ? ObserveScans(args, map, scratch) : Resolve(args.to, map, observer);
+
+    const change::ChangeSet changes =
+        change::DetectChanges(a.observation, b.observation, map.settings().voxel_size_m, query);
+    const change::ReportContext context{a.name, b.name, map.settings().origin, &query};
+    const std::string report = change::ChangeReportJson(changes, context);
+    if (!args.vdb.empty()) change::WriteChangeVdb(changes, context, args.vdb);
+    if (!args.png.empty()) {
+        openvdb::BoolGrid::Ptr seen = a.observation.masks.occupied->deepCopy();
+        seen->topologyUnion(*b.observation.masks.occupied);
+        if (query.region) query.region->Clip(*seen, map.settings().voxel_size_m);
+        change::WriteChangePng(changes, *seen, args.png);
+    }
+    if (args.json) {
+        std::cout << report;
+    } else {
+        PrintSummary(changes, a, b);
+    }
+    if (args.save) {
+        store::ChangeSetRecord record;
+        record.from = a.name;
+        record.to = b.name;
+        record.added_voxels = changes.added_voxels_total;
+        record.removed_voxels = changes.removed_voxels_total;
+        record.unknown_voxels = changes.unknown_voxels;
+        record.objects = changes.objects.size();
+        record.report = report;
+        const int64_t id = map.SaveChangeSet(record);
+        (args.json ? std::cerr : std::cout) << "saved as change set " << id << "\n";
+    }
+}
+
+}  // namespace
+
+void RegisterDiff(CLI::App& app) {
+    auto args = std::make_shared<DiffArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "diff", "What changed: added = occupied in TO and seen free in FROM, removed = occupied "
+                "in FROM and seen free in TO; voxels one side never saw are unknown, never "
+                "changed");
+    cmd->footer(
+        "Examples:\n"
+        "  strata diff street.strata --from 1 --to 2 --png changes.png\n"
+        "  strata diff street.strata --from map@1 --to map --class vehicle --json\n"
+        "  strata diff street.strata --to-kitti new_drive/ --region 0,-10,50,10\n"
+        "  strata diff street.strata --list");
+    cmd->add_option("MAP", args->map, "Map directory")->required();
+    cmd->add_option("--from", args->from, std::string("Before: ") + kSideHelp);
+    cmd->add_option("--to", args->to, std::string("After: ") + kSideHelp);
+    cmd->add_option("--to-kitti", args->to_kitti,
+                    "After: a KITTI sequence not yet integrated (compared with --from, default "
+                    "map)");
+    cmd->add_option("--frames", args->frames, "Frame range A:B of --to-kitti (half-open)");
+    cmd->add_option("--to-scans", args->to_scans, "After: point-cloud files not yet integrated");
+    cmd->add_option("--poses", args->poses, "Pose file for --to-scans (KITTI 3x4 or TUM)");
+    cmd->add_option("--region", args->region,
+                    "Only x0,y0,x1,y1 (a box) or x0,y0,x1,y1,x2,y2,... (a polygon), map frame");
+    cmd->add_option("--class", args->class_name, "Only objects of this class (e.g. vehicle)");
+    cmd->add_option("--min-voxels", args->min_voxels, "Smallest object reported")
+        ->capture_default_str();
+    cmd->add_option("--gap", args->gap, "Gap in voxels that still joins an object")
+        ->capture_default_str();
+    cmd->add_option("--tolerance", args->tolerance,
+                    "Voxels a surface may shift between the sides without being a change")
+        ->capture_default_str();
+    cmd->add_flag("--json", args->json, "Print the JSON report");
+    cmd->add_option("--vdb", args->vdb, "Write the added and removed grids to a .vdb file");
+    cmd->add_option("--png", args->png, "Write a top-down picture (removed red, added green)");
+    cmd->add_flag("--save", args->save, "Keep the result in the map's catalog");
+    cmd->add_flag("--list", args->list, "List the saved change sets");
+    cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace strata::tools
