@@ -41,6 +41,17 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
     echo
     "$build/bench/bench_store" "$root/../shared/data"
   fi
+  if [[ -x "$build/bench/bench_change" ]]; then
+    echo
+    echo "## Change detection (\`bench/bench_change\`)"
+    echo
+    echo "BALM (89 scans, voxel 0.2 m) in a map on disk as two sessions (scans 0-44, 45-88)."
+    echo "A whole-map change query: read both sides from the store (tile files verified and"
+    echo "decoded; a file shared by both sides read once), then \`DetectChanges\` (topology"
+    echo "operations and grouping). Target: well under a second. Semantics: [change.md](change.md)."
+    echo
+    "$build/bench/bench_change" "$root/../shared/data"
+  fi
   if [[ -x "$build/bench/bench_sim" ]]; then
     echo
     echo "## Simulator (\`bench/bench_sim\`)"
