@@ -33,13 +33,14 @@ BoolGrid::Ptr SeenOccupiedAndFree(const BoolGrid& occupied, const core::Occupanc
 }
 
 // The candidates that are changes beyond doubt: minus those within the surface tolerance of
-// occupied(Y) and, when asked, those with a face neighbour Y never observed. Both checks look
+// occupied(Y) and those with a voxel Y never observed within the margin along an axis. Both checks look
 // around the (few) candidates only, instead of dilating Y's surfaces or eroding what Y observed.
 BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& other,
                         const ChangeQuery& query) {
     BoolGrid::Ptr out = Copy(candidates);
     const int t = std::max(0, query.surface_tolerance_voxels);
-    if (t == 0 && !query.require_observed_neighbours) return out;
+    const int m = std::max(0, query.observed_margin_voxels);
+    if (t == 0 && m == 0) return out;
     auto surface = other.occupied->getConstAccessor();
     auto free = other.free->getConstAccessor();
     const auto near_surface = [&](const openvdb::Coord& c) {
@@ -54,10 +55,12 @@ BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& 
     };
     const auto on_rim = [&](const openvdb::Coord& c) {
         for (int axis = 0; axis < 3; ++axis) {
-            for (int step : {-1, 1}) {
-                openvdb::Coord n = c;
-                n[axis] += step;
-                if (!free.isValueOn(n) && !surface.isValueOn(n)) return true;
+            for (int step = 1; step <= m; ++step) {
+                for (int sign : {-1, 1}) {
+                    openvdb::Coord n = c;
+                    n[axis] += sign * step;
+                    if (!free.isValueOn(n) && !surface.isValueOn(n)) return true;
+                }
             }
         }
         return false;
@@ -65,7 +68,7 @@ BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& 
     std::vector<openvdb::Coord> drop;
     for (auto on = out->cbeginValueOn(); on; ++on) {
         const openvdb::Coord c = on.getCoord();
-        if ((t > 0 && near_surface(c)) || (query.require_observed_neighbours && on_rim(c))) {
+        if ((t > 0 && near_surface(c)) || (m > 0 && on_rim(c))) {
             drop.push_back(c);
         }
     }

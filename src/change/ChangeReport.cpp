@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "strata/io/Image.hpp"
@@ -17,7 +18,9 @@ json Vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); 
 json QueryJson(const ChangeQuery& q) {
     json out{{"min_voxels", q.min_voxels},
              {"gap_voxels", q.gap_voxels},
-             {"surface_tolerance_voxels", q.surface_tolerance_voxels}};
+             {"surface_tolerance_voxels", q.surface_tolerance_voxels},
+             {"observed_margin_voxels", q.observed_margin_voxels},
+             {"grow_voxels", q.grow_voxels}};
     if (q.class_filter) out["class"] = core::ClassName(*q.class_filter);
     if (q.region) {
         json vertices = json::array();
@@ -89,43 +92,65 @@ void WriteChangePng(const ChangeSet& changes, const openvdb::BoolGrid& context,
     const double s = changes.voxel_size;
     const openvdb::Coord extent = box.extents();
     const int longest = std::max(extent.x(), extent.y());
+    // Small maps are drawn with several pixels per voxel so the picture stays readable.
+    constexpr int kMinPixels = 800;
     const int voxels_per_pixel = std::max(1, (longest + max_pixels - 1) / max_pixels);
-    const int width = (extent.x() + voxels_per_pixel - 1) / voxels_per_pixel;
-    const int height = (extent.y() + voxels_per_pixel - 1) / voxels_per_pixel;
+    const int pixels_per_voxel =
+        voxels_per_pixel > 1 ? 1 : std::max(1, std::min(8, kMinPixels / std::max(1, longest)));
+    const int width = (extent.x() + voxels_per_pixel - 1) / voxels_per_pixel * pixels_per_voxel;
+    const int height = (extent.y() + voxels_per_pixel - 1) / voxels_per_pixel * pixels_per_voxel;
     io::RgbImage image(width, height, {255, 255, 255});
-    // Column (x) grows east, row grows south: north (+y) is up.
+    // Top-left pixel of the cell holding voxel column (i, j); north (+y) is up.
     const auto pixel = [&](int i, int j) {
-        return std::pair{(i - box.min().x()) / voxels_per_pixel,
-                         height - 1 - (j - box.min().y()) / voxels_per_pixel};
+        return std::pair{(i - box.min().x()) / voxels_per_pixel * pixels_per_voxel,
+                         height - ((j - box.min().y()) / voxels_per_pixel + 1) * pixels_per_voxel};
     };
+    const auto cell = [&](int i, int j, core::Rgb color) {
+        const auto [x, y] = pixel(i, j);
+        image.FillRect(x, y, pixels_per_voxel, pixels_per_voxel, color);
+    };
+    // Context shaded by how many occupied voxels a cell holds: ground light, walls dark.
+    std::map<std::pair<int, int>, int> column;
+    for (auto on = context.cbeginValueOn(); on; ++on) {
+        const openvdb::CoordBBox b = on.getBoundingBox();
+        for (int i = b.min().x(); i <= b.max().x(); ++i) {
+            for (int j = b.min().y(); j <= b.max().y(); ++j) {
+                column[{(i - box.min().x()) / voxels_per_pixel,
+                        (j - box.min().y()) / voxels_per_pixel}] += b.dim().z();
+            }
+        }
+    }
+    for (const auto& [ij, count] : column) {
+        const double t = std::min(1.0, std::log2(1.0 + count) / 5.0);
+        const auto grey = static_cast<uint8_t>(225.0 - 150.0 * t);
+        cell(box.min().x() + ij.first * voxels_per_pixel, box.min().y() + ij.second * voxels_per_pixel,
+             {grey, grey, grey});
+    }
+    const core::Rgb added{0, 170, 0}, removed{220, 0, 0};
     const auto paint = [&](const openvdb::BoolGrid& grid, core::Rgb color) {
         for (auto on = grid.cbeginValueOn(); on; ++on) {
             const openvdb::CoordBBox b = on.getBoundingBox();
             for (int i = b.min().x(); i <= b.max().x(); ++i) {
-                for (int j = b.min().y(); j <= b.max().y(); ++j) {
-                    const auto [x, y] = pixel(i, j);
-                    if (image.Contains(x, y)) image.Set(x, y, color);
-                }
+                for (int j = b.min().y(); j <= b.max().y(); ++j) cell(i, j, color);
             }
         }
     };
-    paint(context, {170, 170, 170});
-    const core::Rgb added{0, 170, 0}, removed{220, 0, 0};
     paint(*changes.removed, removed);
     paint(*changes.added, added);
     for (const ChangeObject& o : changes.objects) {
-        const auto [x0, y1] = pixel(static_cast<int>(std::floor(o.bbox_min.x() / s)),
-                                    static_cast<int>(std::floor(o.bbox_min.y() / s)));
-        const auto [x1, y0] = pixel(static_cast<int>(std::floor(o.bbox_max.x() / s)) - 1,
+        const auto [x0, y0] = pixel(static_cast<int>(std::floor(o.bbox_min.x() / s)),
                                     static_cast<int>(std::floor(o.bbox_max.y() / s)) - 1);
+        const auto [x1, y1] = pixel(static_cast<int>(std::floor(o.bbox_max.x() / s)) - 1,
+                                    static_cast<int>(std::floor(o.bbox_min.y() / s)));
+        const int left = x0 - 3, top = y0 - 3;
+        const int right = x1 + pixels_per_voxel + 2, bottom = y1 + pixels_per_voxel + 2;
         const core::Rgb c = o.kind == ChangeKind::kAdded ? added : removed;
-        const int m = 2;  // frame a little outside the object
-        image.FillRect(x0 - m, y0 - m, x1 - x0 + 1 + 2 * m, 1, c);
-        image.FillRect(x0 - m, y1 + m, x1 - x0 + 1 + 2 * m, 1, c);
-        image.FillRect(x0 - m, y0 - m, 1, y1 - y0 + 1 + 2 * m, c);
-        image.FillRect(x1 + m, y0 - m, 1, y1 - y0 + 1 + 2 * m, c);
+        image.FillRect(left, top, right - left + 1, 1, c);  // a frame a little outside the object
+        image.FillRect(left, bottom, right - left + 1, 1, c);
+        image.FillRect(left, top, 1, bottom - top + 1, c);
+        image.FillRect(right, top, 1, bottom - top + 1, c);
     }
-    io::DrawScaleBar(image, s * voxels_per_pixel);
+    io::DrawScaleBar(image, s * voxels_per_pixel / pixels_per_voxel);
     io::WritePng(image, path);
 }
 

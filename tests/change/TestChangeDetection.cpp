@@ -159,6 +159,7 @@ TEST(ChangeDetection, SafeguardsAndGrowthAtASurface) {
     const Observation b = Side(Mask({floor, block}), Mask({floor, space}));
     ChangeQuery query;
     query.min_voxels = 1;
+    query.surface_tolerance_voxels = 1;
     query.grow_voxels = 0;
     // Layer z = 1 touches A's floor: dropped by the tolerance. z = 2 and 3 remain.
     EXPECT_EQ(DetectChanges(a, b, kVoxel, query).added_voxels_total, 18u);

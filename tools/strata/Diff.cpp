@@ -29,6 +29,8 @@ struct DiffArgs {
     size_t min_voxels = change::ChangeQuery{}.min_voxels;
     int gap = change::ChangeQuery{}.gap_voxels;
     int tolerance = change::ChangeQuery{}.surface_tolerance_voxels;
+    int margin = change::ChangeQuery{}.observed_margin_voxels;
+    int grow = change::ChangeQuery{}.grow_voxels;
     bool json = false;
     std::string vdb;
     std::string png;
@@ -122,7 +124,9 @@ void Run(const DiffArgs& args) {
     if (args.from.empty() && !scans) throw std::invalid_argument("--from SIDE is required");
     if (args.min_voxels < 1) throw std::invalid_argument("--min-voxels must be at least 1");
     if (args.gap < 0) throw std::invalid_argument("--gap must be >= 0");
-    if (args.tolerance < 0) throw std::invalid_argument("--tolerance must be >= 0");
+    if (args.tolerance < 0 || args.margin < 0 || args.grow < 0) {
+        throw std::invalid_argument("--tolerance, --margin and --grow must be >= 0");
+    }
 
     change::ChangeQuery query;
     if (!args.region.empty()) query.region = core::Region::Parse(args.region);
@@ -130,6 +134,8 @@ void Run(const DiffArgs& args) {
     query.min_voxels = args.min_voxels;
     query.gap_voxels = args.gap;
     query.surface_tolerance_voxels = args.tolerance;
+    query.observed_margin_voxels = args.margin;
+    query.grow_voxels = args.grow;
 
     // --save writes the catalog: open as the writer up front, so a busy map fails before work.
     store::MapStore map = args.save ? store::MapStore::Open(args.map, store::MapStore::Access::kWrite)
@@ -201,6 +207,12 @@ void RegisterDiff(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--tolerance", args->tolerance,
                     "Voxels a surface may shift between the sides without being a change")
+        ->capture_default_str();
+    cmd->add_option("--margin", args->margin,
+                    "Voxels around a change the other side must have observed along each axis")
+        ->capture_default_str();
+    cmd->add_option("--grow", args->grow,
+                    "Voxels by which confident changes grow back into the plain candidates")
         ->capture_default_str();
     cmd->add_flag("--json", args->json, "Print the JSON report");
     cmd->add_option("--vdb", args->vdb, "Write the added and removed grids to a .vdb file");

@@ -36,12 +36,12 @@ struct ChangeQuery {
     /// (26-neighbourhood): a wall seen at a grazing angle ends its rays in the next voxel in one
     /// session and the voxel before in the other, which is a shift of the same surface, not a
     /// change. 0 compares voxel by voxel.
-    int surface_tolerance_voxels = 1;
-    /// A changed voxel also needs the other side to have observed its six face neighbours: on
-    /// the rim of what a side saw (the last voxel above ground seen between two far scan rings,
-    /// the edge of a shadow) a single grazing ray decides between free and unknown, which says
-    /// nothing about change.
-    bool require_observed_neighbours = true;
+    int surface_tolerance_voxels = 2;
+    /// A changed voxel also needs the other side to have observed the voxels up to this many
+    /// steps away along each axis: on the rim of what a side saw (the last voxel layers above a
+    /// ground seen only by grazing rays, the edge of a shadow) a grazing ray decides between free
+    /// and unknown, which says nothing about change. 0 disables.
+    int observed_margin_voxels = 1;
     /// Groups of changes that pass both safeguards (and `min_voxels`) grow back into the plain
     /// candidates (occupied on one side, free on the other) by up to this many voxels, so objects
     /// keep the edges the safeguards trimmed (a car's lowest layer above the road, a container's
@@ -95,7 +95,7 @@ struct ChangeSet {
 /// @brief Compares two observations of the same map frame with VDB topology operations (no dense
 /// loops): added = occupied(B) AND free(A), removed = occupied(A) AND free(B), each minus the
 /// voxels near a surface of the other side (`surface_tolerance_voxels`) and on the rim of what it
-/// observed (`require_observed_neighbours`); a voxel unobserved by either side is unknown, never
+/// observed (`observed_margin_voxels`); a voxel unobserved by either side is unknown, never
 /// changed. Changed voxels are grouped into objects.
 /// @throws std::invalid_argument when a mask is missing or `voxel_size` is not positive.
 [[nodiscard]] ChangeSet DetectChanges(const Observation& a, const Observation& b,

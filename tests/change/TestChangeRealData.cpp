@@ -1,0 +1,90 @@
+// Change detection on real recordings split in two (../shared/data): where nothing should change
+// but what moves through, the report must stay small and hold nothing wall-sized.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "strata/change/ChangeDetection.hpp"
+#include "strata/change/MapObserver.hpp"
+#include "strata/io/KittiSequence.hpp"
+#include "strata/store/SessionWriter.hpp"
+
+namespace strata::change {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kVoxel = 0.2;
+// Changed voxels at most this fraction of the voxels both halves observed.
+constexpr double kMaxChangedFraction = 0.002;
+constexpr size_t kMaxObjects = 20;
+
+struct Halves {
+    size_t objects = 0;
+    size_t changed = 0;
+    size_t observed = 0;
+    double longest_m = 0.0;  ///< longest side of any object's oriented box
+};
+
+// Integrates frames [0, split) and [split, end) of a sequence as two sessions and compares them.
+Halves CompareHalves(const fs::path& seq_dir, size_t split, size_t end) {
+    const fs::path dir =
+        fs::temp_directory_path() / ("strata_change_real_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const io::KittiSequence seq = io::OpenKittiSequence(seq_dir);
+    store::StoreSettings settings;
+    settings.voxel_size_m = kVoxel;
+    Halves h;
+    {
+        store::MapStore map = store::MapStore::Create(dir, settings);
+        std::vector<int64_t> ids;
+        for (const auto& [begin, stop] :
+             std::vector<std::pair<size_t, size_t>>{{0, split}, {split, std::min(end, seq.size())}}) {
+            store::SessionWriter writer(map, integration::IntegrationConfig{}, {});
+            for (size_t i = begin; i < stop; ++i) writer.Integrate(io::ReadKittiScan(seq, i));
+            ids.push_back(writer.Commit().id);
+        }
+        MapObserver observer(map);
+        const Observation a = observer.Session(ids[0]);
+        const Observation b = observer.Session(ids[1]);
+        const ChangeSet c = DetectChanges(a, b, kVoxel);
+        openvdb::BoolGrid::Ptr both = a.masks.occupied->deepCopy();
+        both->topologyUnion(*a.masks.free);
+        openvdb::BoolGrid::Ptr seen_b = b.masks.occupied->deepCopy();
+        seen_b->topologyUnion(*b.masks.free);
+        both->topologyIntersection(*seen_b);
+        h.objects = c.objects.size();
+        h.changed = c.added->activeVoxelCount() + c.removed->activeVoxelCount();
+        h.observed = both->activeVoxelCount();
+        for (const ChangeObject& o : c.objects) {
+            h.longest_m = std::max({h.longest_m, o.oriented.size.x(), o.oriented.size.y()});
+        }
+    }
+    fs::remove_all(dir);
+    std::printf("[ change ] %s: %zu objects, %zu of %zu commonly observed voxels changed, longest "
+                "object %.1f m\n",
+                seq_dir.filename().c_str(), h.objects, h.changed, h.observed, h.longest_m);
+    return h;
+}
+
+TEST(ChangeRealData, Kitti00FramesZeroToTwoVersusThreeToFive) {
+    const fs::path seq = fs::path(STRATA_DATA_DIR) / "kitti00";
+    if (!fs::exists(seq / "poses.txt")) GTEST_SKIP() << seq << " not found";
+    const Halves h = CompareHalves(seq, 3, 6);
+    constexpr double kMaxObjectM = 6.0;  // a car, not a facade
+    EXPECT_LE(h.objects, kMaxObjects);
+    EXPECT_LE(static_cast<double>(h.changed), kMaxChangedFraction * h.observed);
+    EXPECT_LE(h.longest_m, kMaxObjectM);
+}
+
+TEST(ChangeRealData, BalmFirstHalfVersusSecondHalf) {
+    const fs::path seq = fs::path(STRATA_DATA_DIR) / "balm";
+    if (!fs::exists(seq / "poses.txt")) GTEST_SKIP() << seq << " not found";
+    const Halves h = CompareHalves(seq, 45, 89);
+    EXPECT_LE(h.objects, kMaxObjects);
+    EXPECT_LE(static_cast<double>(h.changed), kMaxChangedFraction * h.observed);
+}
+
+}  // namespace
+}  // namespace strata::change
