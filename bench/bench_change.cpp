@@ -54,7 +54,7 @@ int Run(const fs::path& data, int repeat) {
         strata::store::StoreSettings settings;
         settings.voxel_size_m = kVoxel;
         strata::store::MapStore map = strata::store::MapStore::Create(dir, settings);
-        const size_t half = scans.size() / 2;
+        const size_t half = (scans.size() + 1) / 2;  // BALM: 0-44 and 45-88
         const std::vector<std::pair<size_t, size_t>> halves{{0, half}, {half, scans.size()}};
         for (const auto& [begin, end] : halves) {
             strata::store::SessionWriter writer(map, strata::integration::IntegrationConfig{}, {});
