@@ -65,10 +65,11 @@ int Run(const fs::path& data, int repeat) {
     const strata::store::MapStore map =
         strata::store::MapStore::Open(dir, strata::store::MapStore::Access::kRead);
 
-    std::printf("| sides | tiles | voxels seen A / B | changed voxels | objects | read sides (s) "
-                "| query (s) | total (s) |\n|---|---|---|---|---|---|---|---|\n");
-    for (const Case& c : {Case{"sessions 1 vs 2 (own layers)", true},
-                          Case{"map as of 1 vs map as of 2", false}}) {
+    std::printf(
+        "| sides | tiles | voxels seen A / B | changed voxels | objects | read sides (s) "
+        "| query (s) | total (s) |\n|---|---|---|---|---|---|---|---|\n");
+    for (const Case& c :
+         {Case{"sessions 1 vs 2 (own layers)", true}, Case{"map as of 1 vs map as of 2", false}}) {
         std::vector<double> read_s, query_s, total_s;
         strata::change::ChangeSet last;
         size_t seen_a = 0, seen_b = 0;

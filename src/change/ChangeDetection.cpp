@@ -33,8 +33,9 @@ BoolGrid::Ptr SeenOccupiedAndFree(const BoolGrid& occupied, const core::Occupanc
 }
 
 // The candidates that are changes beyond doubt: minus those within the surface tolerance of
-// occupied(Y) and those with a voxel Y never observed within the margin along an axis. Both checks look
-// around the (few) candidates only, instead of dilating Y's surfaces or eroding what Y observed.
+// occupied(Y) and those with a voxel Y never observed within the margin along an axis. Both checks
+// look around the (few) candidates only, instead of dilating Y's surfaces or eroding what Y
+// observed.
 BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& other,
                         const ChangeQuery& query) {
     BoolGrid::Ptr out = Copy(candidates);
@@ -99,8 +100,8 @@ BoolGrid::Ptr Changes(const BoolGrid& occupied, const core::OccupancyMasks& othe
     if (query.grow_voxels <= 0) return confident;
     BoolGrid::Ptr cores = confident->copyWithNewTree();
     auto acc = cores->getAccessor();
-    for (const ObjectVoxels& group : GroupObjects(*confident, ChangeKind::kAdded, voxel_size,
-                                                  query.gap_voxels, nullptr)) {
+    for (const ObjectVoxels& group :
+         GroupObjects(*confident, ChangeKind::kAdded, voxel_size, query.gap_voxels, nullptr)) {
         if (group.voxels.size() < query.min_voxels) continue;
         for (const openvdb::Coord& c : group.voxels) acc.setValueOn(c, true);
     }

@@ -65,8 +65,8 @@ std::string ChangeReportJson(const ChangeSet& changes, const ReportContext& cont
 void WriteChangeVdb(const ChangeSet& changes, const ReportContext& context,
                     const std::filesystem::path& path) {
     openvdb::GridCPtrVec grids;
-    for (const auto& [grid, name] : {std::pair{changes.added, "added"},
-                                     std::pair{changes.removed, "removed"}}) {
+    for (const auto& [grid, name] :
+         {std::pair{changes.added, "added"}, std::pair{changes.removed, "removed"}}) {
         openvdb::BoolGrid::Ptr out = grid->deepCopy();
         out->setName(name);
         out->insertMeta("units", openvdb::StringMetadata(std::string(name) + " voxels, " +
@@ -123,8 +123,8 @@ void WriteChangePng(const ChangeSet& changes, const openvdb::BoolGrid& context,
     for (const auto& [ij, count] : column) {
         const double t = std::min(1.0, std::log2(1.0 + count) / 5.0);
         const auto grey = static_cast<uint8_t>(225.0 - 150.0 * t);
-        cell(box.min().x() + ij.first * voxels_per_pixel, box.min().y() + ij.second * voxels_per_pixel,
-             {grey, grey, grey});
+        cell(box.min().x() + ij.first * voxels_per_pixel,
+             box.min().y() + ij.second * voxels_per_pixel, {grey, grey, grey});
     }
     const core::Rgb added{0, 170, 0}, removed{220, 0, 0};
     const auto paint = [&](const openvdb::BoolGrid& grid, core::Rgb color) {

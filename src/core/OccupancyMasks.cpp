@@ -20,8 +20,8 @@ OccupancyMasks SplitOccupancy(const openvdb::FloatGrid& log_odds) {
         for (auto on = leaf->cbeginValueOn(); on; ++on) {
             (*on > 0.0f ? occupied : free).setOn(on.pos());
         }
-        for (auto [grid, mask] : {std::pair{masks.occupied.get(), &occupied},
-                                  std::pair{masks.free.get(), &free}}) {
+        for (auto [grid, mask] :
+             {std::pair{masks.occupied.get(), &occupied}, std::pair{masks.free.get(), &free}}) {
             if (mask->isOff()) continue;
             auto* out = new BoolLeaf(leaf->origin(), false, false);
             out->buffer() = BoolLeaf::Buffer(*mask);

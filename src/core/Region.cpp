@@ -57,7 +57,8 @@ Region Region::Parse(const std::string& text) {
         if (values.size() == 4) return Box(values[0], values[1], values[2], values[3]);
         if (values.size() < 6 || values.size() % 2 != 0) throw bad("wrong number of values");
         std::vector<Eigen::Vector2d> vertices;
-        for (size_t i = 0; i < values.size(); i += 2) vertices.emplace_back(values[i], values[i + 1]);
+        for (size_t i = 0; i < values.size(); i += 2)
+            vertices.emplace_back(values[i], values[i + 1]);
         return Polygon(std::move(vertices));
     } catch (const std::invalid_argument& e) {
         if (std::string(e.what()).rfind("region '", 0) == 0) throw;

@@ -32,10 +32,10 @@ size_t Count(const CoordBBox& b) { return static_cast<size_t>(b.volume()); }
 // A street seen twice: a car leaves, a box arrives, and a wall appears where "before" never saw.
 struct Street {
     CoordBBox world{Coord(0, 0, 0), Coord(99, 29, 9)};
-    CoordBBox car{Coord(10, 10, 0), Coord(19, 14, 4)};       // 250 voxels, in A only
-    CoordBBox box{Coord(40, 10, 0), Coord(44, 14, 4)};       // 125 voxels, in B only
-    CoordBBox shadow{Coord(80, 0, 0), Coord(99, 29, 9)};     // A never saw it
-    CoordBBox wall{Coord(90, 0, 0), Coord(90, 29, 9)};       // B sees it occupied
+    CoordBBox car{Coord(10, 10, 0), Coord(19, 14, 4)};    // 250 voxels, in A only
+    CoordBBox box{Coord(40, 10, 0), Coord(44, 14, 4)};    // 125 voxels, in B only
+    CoordBBox shadow{Coord(80, 0, 0), Coord(99, 29, 9)};  // A never saw it
+    CoordBBox wall{Coord(90, 0, 0), Coord(90, 29, 9)};    // B sees it occupied
     Observation a, b;
 
     Street() {
@@ -124,7 +124,8 @@ TEST(ChangeDetection, GapToleranceJoinsNearbyVoxels) {
     EXPECT_EQ(GroupObjects(*mask, ChangeKind::kAdded, kVoxel, 1, nullptr).size(), 2u);
     EXPECT_EQ(GroupObjects(*mask, ChangeKind::kAdded, kVoxel, 3, nullptr).size(), 1u);
     // Diagonal neighbours touch at gap 0 (26-connectivity).
-    BoolGrid::Ptr diagonal = Mask({{Coord(0, 0, 0), Coord(0, 0, 0)}, {Coord(1, 1, 1), Coord(1, 1, 1)}});
+    BoolGrid::Ptr diagonal =
+        Mask({{Coord(0, 0, 0), Coord(0, 0, 0)}, {Coord(1, 1, 1), Coord(1, 1, 1)}});
     EXPECT_EQ(GroupObjects(*diagonal, ChangeKind::kAdded, kVoxel, 0, nullptr).size(), 1u);
 }
 

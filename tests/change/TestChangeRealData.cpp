@@ -39,8 +39,8 @@ Halves CompareHalves(const fs::path& seq_dir, size_t split, size_t end) {
     {
         store::MapStore map = store::MapStore::Create(dir, settings);
         std::vector<int64_t> ids;
-        for (const auto& [begin, stop] :
-             std::vector<std::pair<size_t, size_t>>{{0, split}, {split, std::min(end, seq.size())}}) {
+        for (const auto& [begin, stop] : std::vector<std::pair<size_t, size_t>>{
+                 {0, split}, {split, std::min(end, seq.size())}}) {
             store::SessionWriter writer(map, integration::IntegrationConfig{}, {});
             for (size_t i = begin; i < stop; ++i) writer.Integrate(io::ReadKittiScan(seq, i));
             ids.push_back(writer.Commit().id);
@@ -62,9 +62,10 @@ Halves CompareHalves(const fs::path& seq_dir, size_t split, size_t end) {
         }
     }
     fs::remove_all(dir);
-    std::printf("[ change ] %s: %zu objects, %zu of %zu commonly observed voxels changed, longest "
-                "object %.1f m\n",
-                seq_dir.filename().c_str(), h.objects, h.changed, h.observed, h.longest_m);
+    std::printf(
+        "[ change ] %s: %zu objects, %zu of %zu commonly observed voxels changed, longest "
+        "object %.1f m\n",
+        seq_dir.filename().c_str(), h.objects, h.changed, h.observed, h.longest_m);
     return h;
 }
 

@@ -2,13 +2,13 @@
 // (datasets/scenes/street_two_sessions.json: cars moved, left and arrived, a container placed, a
 // wall cut, a bush grown). Prints the per-edit table docs/change.md shows.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <unistd.h>
 
 #include "strata/change/ChangeDetection.hpp"
 #include "strata/change/MapObserver.hpp"
@@ -224,7 +224,8 @@ Score Evaluate(const Simulated& s, const ChangeQuery& query, bool strict, bool t
     Score score;
     score.objects = changes.objects.size();
     size_t found = 0, inter_sum = 0, union_sum = 0;
-    if (table) std::printf("[ change ] | edit | change | truth voxels | detected | IoU | objects |\n");
+    if (table)
+        std::printf("[ change ] | edit | change | truth voxels | detected | IoU | objects |\n");
     for (size_t e = 0; e < s.edits.size(); ++e) {
         const Edit& edit = s.edits[e];
         const BoolGrid::Ptr truth = TruthVoxels(s, edit, strict);
@@ -245,15 +246,14 @@ Score Evaluate(const Simulated& s, const ChangeQuery& query, bool strict, bool t
             union_sum += uni;
         }
         if (table) {
-            std::printf("[ change ] | %s (%s) | %s | %zu | %zu | %.3f | %zu |\n",
-                        edit.name.c_str(), edit.kind.c_str(), edit.change.c_str(), t, d,
+            std::printf("[ change ] | %s (%s) | %s | %zu | %zu | %.3f | %zu |\n", edit.name.c_str(),
+                        edit.kind.c_str(), edit.change.c_str(), t, d,
                         uni ? static_cast<double>(inter) / uni : 1.0,
                         matched.count(e) ? matched.at(e) : size_t{0});
         }
     }
-    score.precision = changes.objects.empty()
-                          ? 1.0
-                          : static_cast<double>(true_objects) / changes.objects.size();
+    score.precision =
+        changes.objects.empty() ? 1.0 : static_cast<double>(true_objects) / changes.objects.size();
     score.recall = score.observable ? static_cast<double>(found) / score.observable : 1.0;
     score.iou = union_sum ? static_cast<double>(inter_sum) / union_sum : 1.0;
     return score;
@@ -263,10 +263,10 @@ TEST(ChangeSimulated, StreetTwoSessionsMatchesTheEdits) {
     const Simulated& s = Scene();
     const Score score = Evaluate(s, ChangeQuery{}, /*strict=*/false, /*table=*/true);
     const Score strict = Evaluate(s, ChangeQuery{}, /*strict=*/true, /*table=*/false);
-    std::printf("[ change ] objects %zu, precision %.3f, recall %.3f (%zu observable edits), "
-                "pooled voxel IoU %.3f (strict %.3f)\n",
-                score.objects, score.precision, score.recall, score.observable, score.iou,
-                strict.iou);
+    std::printf(
+        "[ change ] objects %zu, precision %.3f, recall %.3f (%zu observable edits), "
+        "pooled voxel IoU %.3f (strict %.3f)\n",
+        score.objects, score.precision, score.recall, score.observable, score.iou, strict.iou);
     EXPECT_EQ(score.observable, s.edits.size()) << "every edit is in view of both drives";
     EXPECT_GE(score.precision, kMinPrecision);
     EXPECT_GE(score.recall, kMinRecall);
@@ -277,8 +277,9 @@ TEST(ChangeSimulated, StreetTwoSessionsMatchesTheEdits) {
 // What each safeguard of the query buys (docs/change.md prints this table).
 TEST(ChangeSimulated, Ablation) {
     const Simulated& s = Scene();
-    std::printf("[ change ] | surface tolerance | observed margin | grow | objects | "
-                "precision | recall | IoU | IoU (strict) |\n");
+    std::printf(
+        "[ change ] | surface tolerance | observed margin | grow | objects | "
+        "precision | recall | IoU | IoU (strict) |\n");
     const int configs[][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 1, 2},
                               {1, 2, 2}, {2, 1, 2}, {2, 2, 2}, {2, 2, 3}};
     for (const auto& [tolerance, margin, grow] : configs) {

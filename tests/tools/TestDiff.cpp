@@ -1,6 +1,5 @@
 // `strata diff` through the program: a room mapped twice, the second time with a pillar in it.
 #include <gtest/gtest.h>
-
 #include <openvdb/openvdb.h>
 
 #include <nlohmann/json.hpp>
@@ -74,9 +73,12 @@ struct Room {
 
     Room() {
         EXPECT_EQ(Strata("integrate " + map.string() + " --voxel 0.1 --name empty --kitti " +
-                         empty.string()).code, 0);
-        EXPECT_EQ(Strata("integrate " + map.string() + " --name pillar --kitti " +
-                         pillar.string()).code, 0);
+                         empty.string())
+                      .code,
+                  0);
+        EXPECT_EQ(
+            Strata("integrate " + map.string() + " --name pillar --kitti " + pillar.string()).code,
+            0);
     }
 };
 

@@ -62,11 +62,10 @@ Side Resolve(const std::string& text, const store::MapStore& map, change::MapObs
 Side ObserveScans(const DiffArgs& args, const store::MapStore& map, core::VoxelMap& scratch) {
     io::ReadOptions read_options;
     read_options.origin = map.settings().origin;
-    const ScanSource source =
-        args.to_kitti.empty()
-            ? ScanSource::Files({args.to_scans.begin(), args.to_scans.end()}, args.poses,
-                                read_options)
-            : ScanSource::Kitti(args.to_kitti, args.frames);
+    const ScanSource source = args.to_kitti.empty()
+                                  ? ScanSource::Files({args.to_scans.begin(), args.to_scans.end()},
+                                                      args.poses, read_options)
+                                  : ScanSource::Kitti(args.to_kitti, args.frames);
     scratch = map.EmptyMap();
     integration::Integrator integrator(scratch, integration::IntegrationConfig{});
     for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
@@ -80,10 +79,15 @@ void List(const DiffArgs& args) {
     if (args.json) {
         nlohmann::json j = nlohmann::json::array();
         for (const store::ChangeSetRecord& r : sets) {
-            j.push_back({{"id", r.id}, {"commit", r.commit}, {"created_utc", r.created_utc},
-                         {"from", r.from}, {"to", r.to}, {"added_voxels", r.added_voxels},
+            j.push_back({{"id", r.id},
+                         {"commit", r.commit},
+                         {"created_utc", r.created_utc},
+                         {"from", r.from},
+                         {"to", r.to},
+                         {"added_voxels", r.added_voxels},
                          {"removed_voxels", r.removed_voxels},
-                         {"unknown_voxels", r.unknown_voxels}, {"objects", r.objects},
+                         {"unknown_voxels", r.unknown_voxels},
+                         {"objects", r.objects},
                          {"report", nlohmann::json::parse(r.report)}});
         }
         std::cout << j.dump(2) << "\n";
@@ -106,9 +110,9 @@ void PrintSummary(const change::ChangeSet& changes, const Side& a, const Side& b
         std::cout << "  " << std::setw(3) << o.id << "  " << std::setw(7)
                   << change::ChangeKindName(o.kind) << "  " << std::setw(6) << o.voxels
                   << " voxels  " << o.volume_m3 << " m3  at (" << o.centroid.x() << ", "
-                  << o.centroid.y() << ", " << o.centroid.z() << ")  size "
-                  << o.oriented.size.x() << " x " << o.oriented.size.y() << " x "
-                  << o.oriented.size.z() << " m  " << core::ClassName(o.dominant_class) << "\n";
+                  << o.centroid.y() << ", " << o.centroid.z() << ")  size " << o.oriented.size.x()
+                  << " x " << o.oriented.size.y() << " x " << o.oriented.size.z() << " m  "
+                  << core::ClassName(o.dominant_class) << "\n";
     }
 }
 
@@ -138,8 +142,9 @@ void Run(const DiffArgs& args) {
     query.grow_voxels = args.grow;
 
     // --save writes the catalog: open as the writer up front, so a busy map fails before work.
-    store::MapStore map = args.save ? store::MapStore::Open(args.map, store::MapStore::Access::kWrite)
-                                    : OpenMap(args.map);
+    store::MapStore map = args.save
+                              ? store::MapStore::Open(args.map, store::MapStore::Access::kWrite)
+                              : OpenMap(args.map);
     change::MapObserver observer(map, query.region);
     const Side a = Resolve(args.from.empty() ? "map" : args.from, map, observer);
     core::VoxelMap scratch;
@@ -180,9 +185,10 @@ void Run(const DiffArgs& args) {
 void RegisterDiff(CLI::App& app) {
     auto args = std::make_shared<DiffArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "diff", "What changed: added = occupied in TO and seen free in FROM, removed = occupied "
-                "in FROM and seen free in TO; voxels one side never saw are unknown, never "
-                "changed");
+        "diff",
+        "What changed: added = occupied in TO and seen free in FROM, removed = occupied "
+        "in FROM and seen free in TO; voxels one side never saw are unknown, never "
+        "changed");
     cmd->footer(
         "Examples:\n"
         "  strata diff street.strata --from 1 --to 2 --png changes.png\n"

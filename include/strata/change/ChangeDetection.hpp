@@ -98,8 +98,8 @@ struct ChangeSet {
 /// observed (`observed_margin_voxels`); a voxel unobserved by either side is unknown, never
 /// changed. Changed voxels are grouped into objects.
 /// @throws std::invalid_argument when a mask is missing or `voxel_size` is not positive.
-[[nodiscard]] ChangeSet DetectChanges(const Observation& a, const Observation& b,
-                                      double voxel_size, const ChangeQuery& query = {});
+[[nodiscard]] ChangeSet DetectChanges(const Observation& a, const Observation& b, double voxel_size,
+                                      const ChangeQuery& query = {});
 
 /// @brief An object and the voxels it is made of.
 struct ObjectVoxels {
@@ -110,9 +110,8 @@ struct ObjectVoxels {
 /// @brief Groups the active voxels of `mask` into objects (voxels at most `gap_voxels` + 1 apart
 /// in every axis join), with their statistics, largest first (ids not yet assigned). `labels` may
 /// be null.
-[[nodiscard]] std::vector<ObjectVoxels> GroupObjects(const openvdb::BoolGrid& mask,
-                                                     ChangeKind kind, double voxel_size,
-                                                     int gap_voxels,
+[[nodiscard]] std::vector<ObjectVoxels> GroupObjects(const openvdb::BoolGrid& mask, ChangeKind kind,
+                                                     double voxel_size, int gap_voxels,
                                                      const openvdb::Int32Grid* labels);
 
 }  // namespace strata::change
