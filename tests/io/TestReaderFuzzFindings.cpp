@@ -2,10 +2,12 @@
 // readers fail on: each minimized input, embedded, must now be refused or read promptly.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <string>
 
 #include "ReaderTestFiles.hpp"
 #include "strata/io/PointCloudReaders.hpp"
+#include "strata/sim/SceneSpec.hpp"
 
 namespace strata::io {
 
@@ -30,6 +32,20 @@ TEST(PlyReaderFuzzFindings, SkipsAnElementWithoutPropertiesWhateverItsCount) {
     for (float v : {1.f, 2.f, 3.f}) Put<float>(binary, v);
     WriteFile(dir / "empty_items_binary.ply", binary);
     EXPECT_EQ(ReadPly(dir / "empty_items_binary.ply").points.size(), 1u);
+}
+
+// A scene file is a reader's input too (fuzz_scene). A wall 1e120 m long with a window grid
+// made AddWindowGrid loop for ever; the grid is now counted first and refused.
+TEST(SceneSpecFuzzFindings, RefusesAWindowGridTooLargeToFill) {
+    const std::string input = R"({"walls": [{"start": [0, 0], "end": [1e120, 0], "windows": {}}]})";
+    try {
+        (void)sim::ParseSceneSpec(input, "huge_wall.json");
+        ADD_FAILURE() << "no error for a wall of 1e120 m with windows";
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("huge_wall.json"), std::string::npos) << what;
+        EXPECT_NE(what.find("window grid"), std::string::npos) << what;
+    }
 }
 
 }  // namespace strata::io
