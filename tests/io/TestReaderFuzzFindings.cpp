@@ -8,6 +8,7 @@
 #include "ReaderTestFiles.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 #include "strata/sim/SceneSpec.hpp"
+#include "strata/store/MapStore.hpp"
 
 namespace strata::io {
 
@@ -64,6 +65,27 @@ TEST(SceneSpecFuzzFindings, RefusesAWindowGridTooLargeToFill) {
         EXPECT_NE(what.find("huge_wall.json"), std::string::npos) << what;
         EXPECT_NE(what.find("window grid"), std::string::npos) << what;
     }
+}
+
+// Opening a map whose catalog.sqlite is not a database threw from inside the Database
+// constructor, whose destructor then never closed the SQLite connection: one file descriptor
+// lost per refused catalog, until fuzz_catalog could not open files any more (after 23000).
+size_t OpenFileDescriptors() {
+    size_t n = 0;
+    for (const auto& entry : fs::directory_iterator("/proc/self/fd")) n += entry.exists() ? 1 : 0;
+    return n;
+}
+
+TEST(MapStoreFuzzFindings, RefusingADamagedCatalogClosesIt) {
+    TempDir dir;
+    fs::create_directories(dir / "map" / "tiles");
+    WriteFile(dir / "map" / "catalog.sqlite", std::string(4096, 'x'));
+    const size_t before = OpenFileDescriptors();
+    for (int i = 0; i < 20; ++i) {
+        EXPECT_THROW((void)store::MapStore::Open(dir / "map", store::MapStore::Access::kRead),
+                     std::runtime_error);
+    }
+    EXPECT_EQ(OpenFileDescriptors(), before);
 }
 
 }  // namespace strata::io
