@@ -67,10 +67,10 @@ std::string ReadBzip2File(const std::filesystem::path& path) {
             if (error == BZ_OK || error == BZ_STREAM_END) text.append(chunk.data(), n);
             if (text.size() > limit) {
                 BZ2_bzReadClose(&error, bz);
-                throw std::runtime_error(
-                    file + ": decompresses to more than " + std::to_string(limit) + " bytes (" +
-                    std::to_string(kMaxBzip2Ratio) +
-                    " times the file, at least 64 MiB): not point-cloud text");
+                throw std::runtime_error(file + ": decompresses to more than " +
+                                         std::to_string(limit) + " bytes (" +
+                                         std::to_string(kMaxBzip2Ratio) +
+                                         " times the file, at least 64 MiB): not point-cloud text");
             }
         }
         if (error != BZ_STREAM_END) {

@@ -91,7 +91,7 @@ Database::Database(const std::filesystem::path& file, Mode mode) : file_(file) {
         if (mode != Mode::kReadOnly) return;
         // A WAL database needs its -shm file; on a read-only directory SQLite cannot create it.
         if (sqlite3_exec(db_, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr) ==
-                SQLITE_OK) {
+            SQLITE_OK) {
             return;
         }
         if (::access(file.parent_path().c_str(), W_OK) == 0) Fail("cannot read the catalog");

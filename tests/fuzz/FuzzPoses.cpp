@@ -10,10 +10,10 @@ namespace {
 void ExpectRigid(const Eigen::Isometry3d& T) {
     strata::fuzz::Expect(T.matrix().allFinite(), "a non-finite pose");
     const Eigen::Matrix3d R = T.linear();
-    strata::fuzz::Expect((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <
-                                 1e-2 &&
-                             R.determinant() > 0.0,
-                         "a pose whose rotation is not a rotation");
+    strata::fuzz::Expect(
+        (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-2 &&
+            R.determinant() > 0.0,
+        "a pose whose rotation is not a rotation");
 }
 
 }  // namespace

@@ -36,8 +36,8 @@ void RemoveStaleScratchDirs(const fs::path& base) {
 
 fs::path MakeScratchDir() {
     std::error_code ec;
-    const fs::path base = fs::is_directory("/dev/shm", ec) ? fs::path("/dev/shm")
-                                                           : fs::temp_directory_path();
+    const fs::path base =
+        fs::is_directory("/dev/shm", ec) ? fs::path("/dev/shm") : fs::temp_directory_path();
     RemoveStaleScratchDirs(base);
     const fs::path dir = base / (kPrefix + std::to_string(::getpid()));
     fs::remove_all(dir, ec);

@@ -23,7 +23,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using namespace strata;              // NOLINT(google-build-using-namespace): one-off tool
+using namespace strata;                  // NOLINT(google-build-using-namespace): one-off tool
 using namespace strata::io::test_files;  // NOLINT(google-build-using-namespace)
 
 void Seed(const fs::path& out, const std::string& target, const std::string& name,
@@ -110,12 +110,12 @@ void WriteSeeds(const fs::path& out) {
     io::WriteTumPoses(scratch / "tum.txt", {{0.0, T}, {0.1, Eigen::Isometry3d::Identity()}});
     Seed(out, "poses", "kitti.txt", Slurp(scratch / "kitti.txt"));
     Seed(out, "poses", "tum.txt", Slurp(scratch / "tum.txt"));
-    Seed(out, "poses", "calib.txt", "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: " +
-                                        Slurp(scratch / "kitti.txt").substr(0, 40) + "\n");
+    Seed(out, "poses", "calib.txt",
+         "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: " + Slurp(scratch / "kitti.txt").substr(0, 40) + "\n");
     Seed(out, "poses", "times.txt", "0.0\n0.1\n2.5e-1\n");
     // Scenes: the simulator's own scene files.
-    for (const auto& entry : fs::directory_iterator(fs::path(STRATA_SOURCE_DIR) / "datasets" /
-                                                    "scenes")) {
+    for (const auto& entry :
+         fs::directory_iterator(fs::path(STRATA_SOURCE_DIR) / "datasets" / "scenes")) {
         if (entry.path().extension() == ".json") {
             Seed(out, "scene", entry.path().filename().string(), Slurp(entry.path()));
         }
