@@ -12,6 +12,7 @@ packages=(
   libsqlite3-dev sqlite3 libcli11-dev nlohmann-json3-dev liblzf-dev libxxhash-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   bzip2 libbz2-dev
+  clang libclang-rt-14-dev  # tools/fuzz.sh: libFuzzer and the sanitizer runtimes (clang 14)
 )
 
 missing=()

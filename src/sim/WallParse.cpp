@@ -10,6 +10,8 @@
 namespace strata::sim::detail {
 namespace {
 
+constexpr double kMaxGridWindows = 100000.0;  // per wall
+
 // Continues the path with a circular arc tangent to its last segment. Turning towards the back
 // bends the wall away from the street (the front face becomes convex).
 void AppendArc(std::vector<Eigen::Vector2d>& path, double radius, double angle_deg,
@@ -52,6 +54,15 @@ void AddWindowGrid(JsonReader& r, WallSpec& wall) {
     }
     WallFrame frame(wall);
     const double len = frame.length();
+    // Count the grid before filling it: a wall 1e120 m long made this loop run for ever
+    // (found by fuzz_scene). No real facade has more than a few hundred windows.
+    const double windows = std::max(0.0, (len - 2.0 * margin) / spacing + 1.0) *
+                           std::max(0.0, (wall.height_m - sill) / storey + 1.0);
+    if (!(windows <= kMaxGridWindows)) {
+        r.Fail("window grid of about " + std::to_string(windows) + " windows (more than " +
+               std::to_string(static_cast<int>(kMaxGridWindows)) +
+               "): check the wall's length and height, 'spacing' and 'storey'");
+    }
     for (double v0 = sill; v0 + height <= wall.height_m - 0.3; v0 += storey) {
         for (double u0 = margin; u0 + width <= len - margin; u0 += spacing) {
             bool straddles = false;  // a window never wraps around a corner

@@ -138,7 +138,11 @@ Tile DecodeTile(const std::string& bytes, const TileKey& key, const fs::path& pa
     tile.key = key;
     openvdb::GridPtrVec fused;
     for (const auto& grid : grids) {
-        const auto [session, occupied] = ParseLayerName(grid->getName());
+        // Plain variables, not a structured binding: clang before 16 cannot capture a binding
+        // in the lambda below (the fuzz build, tools/fuzz.sh, compiles with clang 14).
+        const std::pair<int64_t, bool> layer_of = ParseLayerName(grid->getName());
+        const int64_t session = layer_of.first;
+        const bool occupied = layer_of.second;
         if (session == 0) {
             fused.push_back(grid);
             continue;

@@ -1,2 +1,3 @@
 # Tests of the scan readers and pose files (included by tests/io/CMakeLists.txt).
-list(APPEND STRATA_IO_TESTS TestPointCloudReaders.cpp TestKittiSequence.cpp TestPoseFiles.cpp)
+list(APPEND STRATA_IO_TESTS TestPointCloudReaders.cpp TestKittiSequence.cpp TestPoseFiles.cpp
+  TestReaderFuzzFindings.cpp)

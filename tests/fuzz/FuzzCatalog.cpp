@@ -1,0 +1,58 @@
+// Opening a map whose catalog.sqlite was replaced by the input (seed: the catalog of a small
+// valid map): SQLite's own checks, then strata's reading of settings, sessions, tile versions
+// and checksums. Open + Latest + ReadTile + LoadMap + Check must throw a std::exception or
+// succeed. The catalog is restored after each input.
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+
+#include "FuzzSupport.hpp"
+#include "MapTemplate.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Template {
+    fs::path dir;
+    std::string catalog;  // original bytes of catalog.sqlite
+};
+
+const Template& TheMap() {
+    static const Template t = [] {
+        Template made;
+        made.dir = strata::fuzz::ScratchDir() / "map";
+        (void)strata::fuzz::CreateSmallMap(made.dir);
+        std::ifstream in(made.dir / "catalog.sqlite", std::ios::binary);
+        made.catalog.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        return made;
+    }();
+    return t;
+}
+
+void WriteCatalog(const Template& t, const std::string& bytes) {
+    std::error_code ec;
+    for (const char* leftover : {"catalog.sqlite-wal", "catalog.sqlite-shm"}) {
+        fs::remove(t.dir / leftover, ec);
+    }
+    std::ofstream out(t.dir / "catalog.sqlite", std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw std::logic_error("fuzz harness: cannot write the catalog");
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    (void)TheMap();
+    return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    const Template& t = TheMap();
+    WriteCatalog(t, std::string(reinterpret_cast<const char*>(data), size));
+    strata::fuzz::ReadWholeMap(t.dir);
+    WriteCatalog(t, t.catalog);
+    return 0;
+}

@@ -1,0 +1,42 @@
+#pragma once
+
+// Shared by the libFuzzer targets (docs/reliability.md, Fuzzing): readers take paths, so each
+// input is written to a file in a per-process scratch folder before the reader opens it.
+
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <string>
+
+#include "strata/core/Scan.hpp"
+
+namespace strata::fuzz {
+
+/// @brief A folder private to this process (under /dev/shm when it exists, so inputs never
+/// touch a disk), created on first use and removed when the process exits normally.
+[[nodiscard]] const std::filesystem::path& ScratchDir();
+
+/// @brief Writes the input to ScratchDir() / name and returns the path.
+std::filesystem::path WriteInput(const uint8_t* data, size_t size, const std::string& name);
+
+/// @brief Runs fn: a std::exception means the reader refused the file, which is the accepted
+/// outcome for a malformed one. Anything else (another exception type, a crash, a sanitizer
+/// report, a hang, running out of memory) escapes to libFuzzer as a bug.
+template <typename Fn>
+void Refusal(Fn fn) {
+    try {
+        fn();
+    } catch (const std::exception&) {
+    }
+}
+
+/// @brief Aborts (a finding for libFuzzer) with `what` when a reader's result breaks its
+/// documented contract: a file it accepted must not hand the map inconsistent data.
+void Expect(bool ok, const char* what);
+
+/// @brief The contract of ReadPointCloud's result: attribute arrays one-to-one with the points,
+/// a finite pose, and (`finite_points`) no non-finite point.
+void ExpectValidScan(const core::Scan& scan, bool finite_points);
+
+}  // namespace strata::fuzz

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang (ASan + UBSan) in build-fuzz/, writes their seed
+# corpora and runs each target for a while; fails when any target finds a crash, a sanitizer
+# report, a hang (-timeout) or runaway memory (-rss_limit_mb). docs/reliability.md, "Fuzzing".
+# Usage: tools/fuzz.sh [SECONDS_PER_TARGET]   (default 20)
+#   STRATA_FUZZ_TARGETS="pcd ply"  only these targets     STRATA_BUILD_JOBS=2  build parallelism
+# Corpora grow in build-fuzz/corpus/<target>/ across runs; crash inputs land in
+# build-fuzz/artifacts/, each target's output in build-fuzz/logs/<target>.log.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+seconds=${1:-20}
+build="$root/build-fuzz"
+targets=(${STRATA_FUZZ_TARGETS:-kitti pcd ply las text text_bz2 poses scene map catalog})
+
+# Largest input per target: a few records beyond the seeds, small enough to mutate quickly.
+declare -A max_len=([kitti]=1024 [pcd]=4096 [ply]=4096 [las]=4096 [text]=2048
+                    [text_bz2]=2048 [poses]=2048 [scene]=8192 [map]=81920
+                    [catalog]=131072)
+
+command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (tools/setup.sh installs it)" >&2; exit 1; }
+launcher=()
+if command -v ccache >/dev/null; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="$root"
+fi
+start=$(date +%s)
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_COMPILER=clang++ -DSTRATA_BUILD_FUZZ=ON -DSTRATA_BUILD_TESTS=OFF \
+  -DSTRATA_BUILD_TOOLS=OFF -DSTRATA_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
+cmake --build "$build" -j "${STRATA_BUILD_JOBS:-$(nproc)}" --target fuzz
+echo "fuzz.sh: build took $(($(date +%s) - start)) s"
+
+rm -rf "$build/seeds"
+"$build/tests/fuzz/fuzz_make_corpus" "$build/seeds"
+mkdir -p "$build/corpus" "$build/artifacts" "$build/logs"
+
+# Leak checking is off: OpenVDB and TBB keep process-lifetime allocations that are not bugs.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
+failed=()
+printf '%-9s %8s %12s %8s  %s\n' target seconds execs corpus result
+for t in "${targets[@]}"; do
+  corpus="$build/corpus/$t"
+  mkdir -p "$corpus"
+  dirs=("$corpus" "$build/seeds/$t")
+  [[ -d "$root/tests/fuzz/seeds/$t" ]] && dirs+=("$root/tests/fuzz/seeds/$t")
+  log="$build/logs/$t.log"
+  result=ok
+  "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -max_len="${max_len[$t]}" \
+    -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
+    -artifact_prefix="$build/artifacts/$t-" "${dirs[@]}" >"$log" 2>&1 || result=FAILED
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  printf '%-9s %8s %12s %8s  %s\n' "$t" "$seconds" "${execs:-?}" \
+    "$(find "$corpus" -type f | wc -l)" "$result"
+  if [[ $result != ok ]]; then
+    failed+=("$t")
+    grep -m3 -E 'ERROR: |runtime error|SUMMARY' "$log" | sed 's/^/    /' || true
+  fi
+done
+echo "fuzz.sh: total $(($(date +%s) - start)) s"
+if ((${#failed[@]})); then
+  echo "fuzz.sh: crashes in: ${failed[*]} (inputs in $build/artifacts, logs in $build/logs)" >&2
+  exit 1
+fi
