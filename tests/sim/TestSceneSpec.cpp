@@ -148,4 +148,18 @@ TEST(SceneSpec, DocumentationExampleParses) {
     EXPECT_EQ(ObjectsOfSession(spec, 1).size() + 1, spec.objects.size());
 }
 
+// A fuzz finding (fuzz_scene, docs/reliability.md). A wall 1e120 m long with a window grid
+// made AddWindowGrid loop for ever; the grid is now counted first and refused.
+TEST(SceneSpecFuzzFindings, RefusesAWindowGridTooLargeToFill) {
+    const std::string input = R"({"walls": [{"start": [0, 0], "end": [1e120, 0], "windows": {}}]})";
+    try {
+        (void)ParseSceneSpec(input, "huge_wall.json");
+        ADD_FAILURE() << "no error for a wall of 1e120 m with windows";
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("huge_wall.json"), std::string::npos) << what;
+        EXPECT_NE(what.find("window grid"), std::string::npos) << what;
+    }
+}
+
 }  // namespace strata::sim

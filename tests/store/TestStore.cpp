@@ -449,4 +449,25 @@ TEST(Store, ReadOnlyMapsOpenForReadingOnly) {
     fs::permissions(dir / "catalog.sqlite", fs::perms::owner_write, fs::perm_options::add);
 }
 
+// A fuzz finding (fuzz_catalog, docs/reliability.md). Opening a map whose catalog.sqlite is not a database threw from inside the Database
+// constructor, whose destructor then never closed the SQLite connection: one file descriptor
+// lost per refused catalog, until fuzz_catalog could not open files any more (after 23000).
+size_t OpenFileDescriptors() {
+    size_t n = 0;
+    for (const auto& entry : fs::directory_iterator("/proc/self/fd")) n += entry.exists() ? 1 : 0;
+    return n;
+}
+
+TEST(MapStoreFuzzFindings, RefusingADamagedCatalogClosesIt) {
+    const fs::path map = Temp("damaged_catalog");
+    fs::create_directories(map / "tiles");
+    std::ofstream(map / "catalog.sqlite") << std::string(4096, 'x');
+    const size_t before = OpenFileDescriptors();
+    for (int i = 0; i < 20; ++i) {
+        EXPECT_THROW((void)MapStore::Open(map, MapStore::Access::kRead), std::runtime_error);
+    }
+    EXPECT_EQ(OpenFileDescriptors(), before);
+}
+
+
 }  // namespace
