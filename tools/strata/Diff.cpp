@@ -59,14 +59,14 @@ Side Resolve(const std::string& text, const store::MapStore& map, change::MapObs
 }
 
 // The scans of --to-kitti / --to-scans integrated in memory with the map's voxel size and origin.
-Side ObserveScans(const DiffArgs& args, const store::MapStore& map, core::VoxelMap& scratch) {
+Side ObserveScans(const DiffArgs& args, const store::MapStore& map) {
     io::ReadOptions read_options;
     read_options.origin = map.settings().origin;
     const ScanSource source = args.to_kitti.empty()
                                   ? ScanSource::Files({args.to_scans.begin(), args.to_scans.end()},
                                                       args.poses, read_options)
                                   : ScanSource::Kitti(args.to_kitti, args.frames);
-    scratch = map.EmptyMap();
+    core::VoxelMap scratch = map.EmptyMap();  // the Observation shares its grids
     integration::Integrator integrator(scratch, integration::IntegrationConfig{});
     for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
     return {change::ObserveMap(scratch),
@@ -147,8 +147,7 @@ void Run(const DiffArgs& args) {
                               : OpenMap(args.map);
     change::MapObserver observer(map, query.region);
     const Side a = Resolve(args.from.empty() ? "map" : args.from, map, observer);
-    core::VoxelMap scratch;
-    const Side b = scans ? ObserveScans(args, map, scratch) : Resolve(args.to, map, observer);
+    const Side b = scans ? ObserveScans(args, map) : Resolve(args.to, map, observer);
 
     const change::ChangeSet changes =
         change::DetectChanges(a.observation, b.observation, map.settings().voxel_size_m, query);
