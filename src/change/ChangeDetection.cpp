@@ -41,7 +41,7 @@ BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& 
     BoolGrid::Ptr out = Copy(candidates);
     const int t = std::max(0, query.surface_tolerance_voxels);
     const int m = std::max(0, query.observed_margin_voxels);
-    if (t == 0 && m == 0) return out;
+    if (t == 0 && m == 0 && query.support_depth_voxels <= 0) return out;
     auto surface = other.occupied->getConstAccessor();
     auto free = other.free->getConstAccessor();
     const auto near_surface = [&](const openvdb::Coord& c) {
@@ -66,10 +66,21 @@ BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& 
         }
         return false;
     };
+    // Down the column: did the other side observe everything below, down to a surface it saw
+    // or to the depth? (A floor seen only by grazing rays has unknown ground right under it.)
+    const int depth = std::max(0, query.support_depth_voxels);
+    const auto unsupported = [&](openvdb::Coord c) {
+        for (int k = 0; k < depth; ++k) {
+            c.z() -= 1;
+            if (surface.isValueOn(c)) return false;
+            if (!free.isValueOn(c)) return true;
+        }
+        return false;
+    };
     std::vector<openvdb::Coord> drop;
     for (auto on = out->cbeginValueOn(); on; ++on) {
         const openvdb::Coord c = on.getCoord();
-        if ((t > 0 && near_surface(c)) || (m > 0 && on_rim(c))) {
+        if ((t > 0 && near_surface(c)) || (m > 0 && on_rim(c)) || (depth > 0 && unsupported(c))) {
             drop.push_back(c);
         }
     }

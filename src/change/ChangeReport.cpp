@@ -20,7 +20,8 @@ json QueryJson(const ChangeQuery& q) {
              {"gap_voxels", q.gap_voxels},
              {"surface_tolerance_voxels", q.surface_tolerance_voxels},
              {"observed_margin_voxels", q.observed_margin_voxels},
-             {"grow_voxels", q.grow_voxels}};
+             {"grow_voxels", q.grow_voxels},
+             {"support_depth_voxels", q.support_depth_voxels}};
     if (q.class_filter) out["class"] = core::ClassName(*q.class_filter);
     if (q.region) {
         json vertices = json::array();

@@ -30,18 +30,20 @@ Observation Side(BoolGrid::Ptr occupied, BoolGrid::Ptr free) {
 size_t Count(const CoordBBox& b) { return static_cast<size_t>(b.volume()); }
 
 // A street seen twice: a car leaves, a box arrives, and a wall appears where "before" never saw.
+// Both stand on a road (z = 0) that both sides saw.
 struct Street {
     CoordBBox world{Coord(0, 0, 0), Coord(99, 29, 9)};
-    CoordBBox car{Coord(10, 10, 0), Coord(19, 14, 4)};    // 250 voxels, in A only
-    CoordBBox box{Coord(40, 10, 0), Coord(44, 14, 4)};    // 125 voxels, in B only
+    CoordBBox road{Coord(0, 0, 0), Coord(99, 29, 0)};
+    CoordBBox car{Coord(10, 10, 1), Coord(19, 14, 5)};    // 250 voxels, in A only
+    CoordBBox box{Coord(40, 10, 1), Coord(44, 14, 5)};    // 125 voxels, in B only
     CoordBBox shadow{Coord(80, 0, 0), Coord(99, 29, 9)};  // A never saw it
-    CoordBBox wall{Coord(90, 0, 0), Coord(90, 29, 9)};    // B sees it occupied
+    CoordBBox wall{Coord(90, 0, 1), Coord(90, 29, 9)};    // B sees it occupied
     Observation a, b;
 
     Street() {
-        BoolGrid::Ptr seen_a = Mask({{world.min(), Coord(79, 29, 9)}});
-        a = Side(Mask({car}), seen_a);
-        b = Side(Mask({box, wall}), Mask({world}));
+        const CoordBBox seen_by_a(world.min(), Coord(79, 29, 9));
+        a = Side(Mask({car, {road.min(), Coord(79, 29, 0)}}), Mask({seen_by_a}));
+        b = Side(Mask({box, wall, road}), Mask({world}));
     }
 };
 
@@ -82,9 +84,9 @@ TEST(ChangeDetection, ObjectStatisticsOfABox) {
     const ChangeObject& car = changes.objects[0];
     constexpr double kTol = 1e-9;
     EXPECT_NEAR(car.volume_m3, 250 * kVoxel * kVoxel * kVoxel, kTol);
-    EXPECT_TRUE(car.bbox_min.isApprox(Eigen::Vector3d(2.0, 2.0, 0.0), kTol));
-    EXPECT_TRUE(car.bbox_max.isApprox(Eigen::Vector3d(4.0, 3.0, 1.0), kTol));
-    EXPECT_TRUE(car.centroid.isApprox(Eigen::Vector3d(3.0, 2.5, 0.5), kTol));
+    EXPECT_TRUE(car.bbox_min.isApprox(Eigen::Vector3d(2.0, 2.0, 0.2), kTol));
+    EXPECT_TRUE(car.bbox_max.isApprox(Eigen::Vector3d(4.0, 3.0, 1.2), kTol));
+    EXPECT_TRUE(car.centroid.isApprox(Eigen::Vector3d(3.0, 2.5, 0.7), kTol));
     EXPECT_NEAR(std::abs(car.oriented.yaw_deg), 0.0, 1e-6);
     EXPECT_TRUE(car.oriented.size.isApprox(Eigen::Vector3d(2.0, 1.0, 1.0), kTol));
     EXPECT_EQ(car.dominant_class, core::SemanticClass::kUnknown);  // no labels given
@@ -141,8 +143,9 @@ TEST(ChangeDetection, MinimumSizeDropsSpeckles) {
     EXPECT_EQ(changes.added->activeVoxelCount(), Count(s.box));
 
     // Without growth the speck is a change (but still no object), and the box loses its bottom
-    // layer: A never observed below z = 0, so that layer is on the rim of what A saw.
+    // layer: it lies within the surface tolerance of A's road.
     query.grow_voxels = 0;
+    query.surface_tolerance_voxels = 1;
     const ChangeSet plain = DetectChanges(s.a, s.b, kVoxel, query);
     const size_t bottom_layer = 5 * 5;
     EXPECT_EQ(plain.objects.size(), 2u);
@@ -169,6 +172,21 @@ TEST(ChangeDetection, SafeguardsAndGrowthAtASurface) {
     query.surface_tolerance_voxels = 0;
     query.grow_voxels = 0;
     EXPECT_EQ(DetectChanges(a, b, kVoxel, query).added_voxels_total, Count(block));
+}
+
+TEST(ChangeDetection, AFloorSeenOnlyFromAboveIsNotRemoved) {
+    // A saw a two-voxel-thick floor occupied; B's grazing rays crossed both layers (free) but
+    // nothing under them, so B never saw what is below: the floor did not go anywhere.
+    const CoordBBox floor(Coord(0, 0, 0), Coord(19, 19, 1));
+    const CoordBBox space(Coord(0, 0, 2), Coord(19, 19, 8));
+    const Observation a = Side(Mask({floor}), Mask({floor, space}));
+    const Observation b = Side(Mask({}), Mask({floor, space}));
+    ChangeQuery query;
+    query.min_voxels = 1;
+    query.observed_margin_voxels = 0;  // this test is about the support rule alone
+    EXPECT_EQ(DetectChanges(a, b, kVoxel, query).removed_voxels_total, 0u);
+    query.support_depth_voxels = 0;
+    EXPECT_GT(DetectChanges(a, b, kVoxel, query).removed_voxels_total, 0u);
 }
 
 TEST(ChangeDetection, RegionRestrictsEverything) {

@@ -83,8 +83,10 @@ TEST(ChangeRealData, BalmFirstHalfVersusSecondHalf) {
     const fs::path seq = fs::path(STRATA_DATA_DIR) / "balm";
     if (!fs::exists(seq / "poses.txt")) GTEST_SKIP() << seq << " not found";
     const Halves h = CompareHalves(seq, 45, 89);
+    constexpr double kMaxObjectM = 6.0;  // nothing wall- or floor-sized
     EXPECT_LE(h.objects, kMaxObjects);
     EXPECT_LE(static_cast<double>(h.changed), kMaxChangedFraction * h.observed);
+    EXPECT_LE(h.longest_m, kMaxObjectM);
 }
 
 }  // namespace

@@ -31,6 +31,7 @@ struct DiffArgs {
     int tolerance = change::ChangeQuery{}.surface_tolerance_voxels;
     int margin = change::ChangeQuery{}.observed_margin_voxels;
     int grow = change::ChangeQuery{}.grow_voxels;
+    int support = change::ChangeQuery{}.support_depth_voxels;
     bool json = false;
     std::string vdb;
     std::string png;
@@ -128,8 +129,8 @@ void Run(const DiffArgs& args) {
     if (args.from.empty() && !scans) throw std::invalid_argument("--from SIDE is required");
     if (args.min_voxels < 1) throw std::invalid_argument("--min-voxels must be at least 1");
     if (args.gap < 0) throw std::invalid_argument("--gap must be >= 0");
-    if (args.tolerance < 0 || args.margin < 0 || args.grow < 0) {
-        throw std::invalid_argument("--tolerance, --margin and --grow must be >= 0");
+    if (args.tolerance < 0 || args.margin < 0 || args.grow < 0 || args.support < 0) {
+        throw std::invalid_argument("--tolerance, --margin, --grow and --support must be >= 0");
     }
 
     change::ChangeQuery query;
@@ -140,6 +141,7 @@ void Run(const DiffArgs& args) {
     query.surface_tolerance_voxels = args.tolerance;
     query.observed_margin_voxels = args.margin;
     query.grow_voxels = args.grow;
+    query.support_depth_voxels = args.support;
 
     // --save writes the catalog: open as the writer up front, so a busy map fails before work.
     store::MapStore map = args.save
@@ -218,6 +220,9 @@ void RegisterDiff(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--grow", args->grow,
                     "Voxels by which confident changes grow back into the plain candidates")
+        ->capture_default_str();
+    cmd->add_option("--support", args->support,
+                    "Voxels below a change within which the other side must have seen a surface")
         ->capture_default_str();
     cmd->add_flag("--json", args->json, "Print the JSON report");
     cmd->add_option("--vdb", args->vdb, "Write the added and removed grids to a .vdb file");

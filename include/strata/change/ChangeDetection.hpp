@@ -42,6 +42,11 @@ struct ChangeQuery {
     /// ground seen only by grazing rays, the edge of a shadow) a grazing ray decides between free
     /// and unknown, which says nothing about change. 0 disables.
     int observed_margin_voxels = 1;
+    /// Below a changed voxel the other side must have observed every voxel, down to a surface it
+    /// saw or this many voxels: a floor seen only by grazing rays has unknown ground right under
+    /// its top layer, while the space under a car that left was seen down to the road. 0
+    /// disables.
+    int support_depth_voxels = 3;
     /// Groups of changes that pass both safeguards (and `min_voxels`) grow back into the plain
     /// candidates (occupied on one side, free on the other) by up to this many voxels, so objects
     /// keep the edges the safeguards trimmed (a car's lowest layer above the road, a container's
