@@ -36,10 +36,7 @@ void WriteCatalog(const Template& t, const std::string& bytes) {
     for (const char* leftover : {"catalog.sqlite-wal", "catalog.sqlite-shm"}) {
         fs::remove(t.dir / leftover, ec);
     }
-    std::ofstream out(t.dir / "catalog.sqlite", std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw std::logic_error("fuzz harness: cannot write the catalog");
+    strata::fuzz::WriteBytes(t.dir / "catalog.sqlite", bytes.data(), bytes.size());
 }
 
 }  // namespace

@@ -67,10 +67,7 @@ void RecordInCatalog(const Template& t, const std::string& bytes) {
 }
 
 void WriteTile(const Template& t, const std::string& bytes) {
-    std::ofstream out(t.dir / t.tile, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw std::logic_error("fuzz harness: cannot write the tile file");
+    strata::fuzz::WriteBytes(t.dir / t.tile, bytes.data(), bytes.size());
 }
 
 }  // namespace

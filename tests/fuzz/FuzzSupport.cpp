@@ -61,12 +61,16 @@ const fs::path& ScratchDir() {
     return dir;
 }
 
-fs::path WriteInput(const uint8_t* data, size_t size, const std::string& name) {
-    const fs::path path = ScratchDir() / name;
+void WriteBytes(const fs::path& path, const char* data, size_t size) {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    out.write(data, static_cast<std::streamsize>(size));
     out.close();
     if (!out) throw std::logic_error("fuzz harness: cannot write " + path.string());
+}
+
+fs::path WriteInput(const uint8_t* data, size_t size, const std::string& name) {
+    const fs::path path = ScratchDir() / name;
+    WriteBytes(path, reinterpret_cast<const char*>(data), size);
     return path;
 }
 

@@ -20,6 +20,10 @@ namespace strata::fuzz {
 /// @brief Writes the input to ScratchDir() / name and returns the path.
 std::filesystem::path WriteInput(const uint8_t* data, size_t size, const std::string& name);
 
+/// @brief Replaces `path` with `size` bytes; throws std::logic_error (a harness failure, not a
+/// finding) when it cannot.
+void WriteBytes(const std::filesystem::path& path, const char* data, size_t size);
+
 /// @brief Runs fn: a std::exception means the reader refused the file, which is the accepted
 /// outcome for a malformed one. Anything else (another exception type, a crash, a sanitizer
 /// report, a hang, running out of memory) escapes to libFuzzer as a bug.
