@@ -1,5 +1,6 @@
 #include "strata/core/VoxelMap.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "strata/core/Labels.hpp"
@@ -35,6 +36,11 @@ typename GridT::Ptr FindGrid(const openvdb::GridPtrVec& grids, const char* name)
     throw std::runtime_error(std::string("the map has no '") + name + "' grid");
 }
 
+bool HasGrid(const openvdb::GridPtrVec& grids, const char* name) {
+    return std::any_of(grids.begin(), grids.end(),
+                       [&](const auto& g) { return g && g->getName() == name; });
+}
+
 }  // namespace
 
 openvdb::math::Transform::Ptr VoxelMap::MakeTransform(double voxel_size_m) {
@@ -63,12 +69,14 @@ VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
                                                     openvdb::GRID_UNKNOWN);
     map.hits = MakeGrid<openvdb::Int32Grid>(grid_names::kHits, xform, "points",
                                             openvdb::GRID_UNKNOWN);
+    map.point_mean = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean, xform,
+                                                  "m from the voxel centre", openvdb::GRID_UNKNOWN);
     map.label->insertMeta("class_legend", openvdb::StringMetadata(LegendJson()));
     return map;
 }
 
 openvdb::GridPtrVec VoxelMap::Grids() const {
-    openvdb::GridPtrVec grids{occupancy, label, label_weight, hits};
+    openvdb::GridPtrVec grids{occupancy, label, label_weight, hits, point_mean};
     for (auto& g : grids) {
         g->insertMeta("producer", openvdb::StringMetadata(kProducer));
         g->insertMeta("origin", openvdb::Vec3DMetadata(openvdb::Vec3d(origin.x(), origin.y(),
@@ -83,6 +91,14 @@ VoxelMap VoxelMap::FromGrids(const openvdb::GridPtrVec& grids) {
     map.label = FindGrid<openvdb::Int32Grid>(grids, grid_names::kLabel);
     map.label_weight = FindGrid<openvdb::FloatGrid>(grids, grid_names::kLabelWeight);
     map.hits = FindGrid<openvdb::Int32Grid>(grids, grid_names::kHits);
+    if (HasGrid(grids, grid_names::kPointMean)) {
+        map.point_mean = FindGrid<openvdb::Vec3SGrid>(grids, grid_names::kPointMean);
+    } else {  // written before the grid existed
+        map.point_mean = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean,
+                                                      map.occupancy->transform().copy(),
+                                                      "m from the voxel centre",
+                                                      openvdb::GRID_UNKNOWN);
+    }
     const openvdb::Vec3d vs = map.occupancy->voxelSize();
     if (!(vs[0] > 0.0) || vs[0] != vs[1] || vs[0] != vs[2]) {
         throw std::runtime_error("the occupancy grid does not have cubic voxels");
@@ -90,7 +106,7 @@ VoxelMap VoxelMap::FromGrids(const openvdb::GridPtrVec& grids) {
     map.voxel_size = vs[0];
     const auto expected = MakeTransform(map.voxel_size);
     for (const auto& g : {openvdb::GridBase::Ptr(map.label), openvdb::GridBase::Ptr(map.label_weight),
-                          openvdb::GridBase::Ptr(map.hits)}) {
+                          openvdb::GridBase::Ptr(map.hits), openvdb::GridBase::Ptr(map.point_mean)}) {
         if (g->transform() != *expected) {
             throw std::runtime_error("grid '" + g->getName() + "' is not aligned with 'occupancy'");
         }
@@ -112,6 +128,15 @@ openvdb::Coord VoxelMap::WorldToVoxel(const Eigen::Vector3d& p_map) const {
 Eigen::Vector3d VoxelMap::VoxelCenter(const openvdb::Coord& ijk) const {
     return (Eigen::Vector3d(ijk.x(), ijk.y(), ijk.z()) + Eigen::Vector3d::Constant(0.5)) *
            voxel_size;
+}
+
+Eigen::Vector3d VoxelMap::PointMean(const openvdb::Coord& ijk) const {
+    Eigen::Vector3d p = VoxelCenter(ijk);
+    openvdb::Vec3s offset;
+    if (point_mean && point_mean->tree().probeValue(ijk, offset)) {
+        p += Eigen::Vector3d(offset[0], offset[1], offset[2]);
+    }
+    return p;
 }
 
 }  // namespace strata::core

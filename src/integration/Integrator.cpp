@@ -13,30 +13,42 @@
 namespace strata::integration {
 namespace {
 
-// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted.
+// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted;
+// then adds each point's offset from its voxel centre to its group (found by binary search).
 std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
                                           const core::Scan& scan) {
-    std::vector<uint64_t> keys(prepared.endpoint_pos.size());
-    for (size_t i = 0; i < keys.size(); ++i) {
+    const auto key_of = [&](size_t i) {
         const auto label = scan.has_labels() ? scan.labels[prepared.endpoint_point[i]]
                                              : core::SemanticClass::kUnknown;
-        keys[i] = (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
-                  static_cast<uint64_t>(label);
-    }
+        return (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
+               static_cast<uint64_t>(label);
+    };
+    std::vector<uint64_t> keys(prepared.endpoint_pos.size());
+    for (size_t i = 0; i < keys.size(); ++i) keys[i] = key_of(i);
     int key_bits = 8;  // class id
     while ((int64_t{1} << (key_bits - 8)) < prepared.box.size()) ++key_bits;
     detail::RadixSort(keys, key_bits);
     std::vector<EndpointGroup> groups;
+    std::vector<uint64_t> unique;  // the key of each group
     const detail::VoxelBox& box = prepared.box;
     for (size_t i = 0; i < keys.size();) {
         size_t j = i;
         while (j < keys.size() && keys[j] == keys[i]) ++j;
-        EndpointGroup g;
-        g.ijk = box.CoordOf(static_cast<int64_t>(keys[i] >> 8));
-        g.points = static_cast<int32_t>(j - i);
-        g.label = static_cast<core::SemanticClass>(keys[i] & 0xff);
-        groups.push_back(g);
+        groups.push_back(EndpointGroup{box.CoordOf(static_cast<int64_t>(keys[i] >> 8)),
+                                       static_cast<int32_t>(j - i),
+                                       static_cast<core::SemanticClass>(keys[i] & 0xff),
+                                       Eigen::Vector3d::Zero()});
+        unique.push_back(keys[i]);
         i = j;
+    }
+    for (size_t i = 0; i < prepared.endpoint_pos.size(); ++i) {
+        const size_t g = static_cast<size_t>(
+            std::lower_bound(unique.begin(), unique.end(), key_of(i)) - unique.begin());
+        const openvdb::Coord& c = groups[g].ijk;
+        const Eigen::Vector3d centre =
+            (Eigen::Vector3d(c.x(), c.y(), c.z()) + Eigen::Vector3d::Constant(0.5)) *
+            prepared.voxel_size;
+        groups[g].offset_sum += prepared.ends[prepared.endpoint_point[i]] - centre;
     }
     return groups;
 }

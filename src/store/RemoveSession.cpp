@@ -62,6 +62,7 @@ int64_t MapStore::RemoveSession(int64_t session_id) {
         auto label = tile.fused.label->getAccessor();
         auto weight = tile.fused.label_weight->getAccessor();
         auto hits = tile.fused.hits->getAccessor();
+        auto mean = tile.fused.point_mean->getAccessor();
         for (auto it = seen.cbeginValueOn(); it; ++it) {
             const openvdb::Coord ijk = it.getCoord();
             float value = 0.0f;
@@ -84,6 +85,7 @@ int64_t MapStore::RemoveSession(int64_t session_id) {
                 label.setValueOff(ijk, 0);
                 weight.setValueOff(ijk, 0.0f);
                 hits.setValueOff(ijk, 0);
+                mean.setValueOff(ijk, openvdb::Vec3s(0.0f));
             }
         }
         TileVersion v;

@@ -172,7 +172,8 @@ Tile DecodeTile(const std::string& bytes, const TileKey& key, const fs::path& pa
     }
     for (const auto& grid : fused) {
         if (grid != tile.fused.occupancy && grid != tile.fused.label &&
-            grid != tile.fused.label_weight && grid != tile.fused.hits) {
+            grid != tile.fused.label_weight && grid != tile.fused.hits &&
+            grid != tile.fused.point_mean) {
             tile.products.push_back(grid);
         }
     }

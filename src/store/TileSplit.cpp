@@ -8,6 +8,7 @@ std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapS
     auto label = StealTiles(*work.label, settings, keys);
     auto label_weight = StealTiles(*work.label_weight, settings, keys);
     auto hits = StealTiles(*work.hits, settings, keys);
+    auto point_mean = StealTiles(*work.point_mean, settings, keys);
     std::map<TileKey, core::VoxelMap> out;
     const auto take = [](auto& tiles, const TileKey& key, auto& grid) {
         const auto it = tiles.find(key);
@@ -20,6 +21,7 @@ std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapS
     add_keys(label);
     add_keys(label_weight);
     add_keys(hits);
+    add_keys(point_mean);
     for (auto& [key, tile] : out) {
         tile.voxel_size = work.voxel_size;
         tile.origin = work.origin;
@@ -27,10 +29,12 @@ std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapS
         tile.label = work.label->copyWithNewTree();
         tile.label_weight = work.label_weight->copyWithNewTree();
         tile.hits = work.hits->copyWithNewTree();
+        tile.point_mean = work.point_mean->copyWithNewTree();
         take(occupancy, key, tile.occupancy);
         take(label, key, tile.label);
         take(label_weight, key, tile.label_weight);
         take(hits, key, tile.hits);
+        take(point_mean, key, tile.point_mean);
     }
     return out;
 }
@@ -40,6 +44,7 @@ void MergeMap(core::VoxelMap& into, core::VoxelMap& tile) {
     MergeLeaves(*into.label, *tile.label);
     MergeLeaves(*into.label_weight, *tile.label_weight);
     MergeLeaves(*into.hits, *tile.hits);
+    MergeLeaves(*into.point_mean, *tile.point_mean);
 }
 
 }  // namespace strata::store::detail

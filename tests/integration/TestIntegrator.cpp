@@ -120,6 +120,20 @@ TEST(Integrator, DropsInvalidAndTooClosePoints) {
     EXPECT_EQ(ActiveVoxels(*update.occupied), (std::set<Key>{{4, 0, 0}}));
 }
 
+TEST(Integrator, KeepsTheMeanEndpointOfEachVoxelAcrossScans) {
+    constexpr double kTol = 1e-5;  // float offsets
+    core::VoxelMap map = core::VoxelMap::Create(0.5);
+    Integrator integrator(map, {});
+    const Eigen::Vector3d origin(0.1, 0.1, 0.1);
+    // Voxel (4, 0, 0) spans x in [2, 2.5): two points in the first scan, one in the second.
+    integrator.Integrate(MakeScan({{2.1, 0.2, 0.3}, {2.3, 0.4, 0.1}}, origin));
+    integrator.Integrate(MakeScan({{2.2, 0.3, 0.35}}, origin));
+    EXPECT_EQ(map.hits->tree().getValue({4, 0, 0}), 3);
+    EXPECT_TRUE(map.PointMean({4, 0, 0}).isApprox(Eigen::Vector3d(2.2, 0.3, 0.25), kTol));
+    // A voxel with no endpoint has no mean: its centre stands in.
+    EXPECT_FALSE(map.point_mean->tree().isValueOn({2, 0, 0}));
+}
+
 TEST(Integrator, ClampsLogOddsLikeOctomap) {
     core::VoxelMap map = core::VoxelMap::Create(1.0);
     Integrator integrator(map, IntegrationConfig{});

@@ -66,14 +66,15 @@ TEST(VdbExport, RoundTripKeepsEveryGridAndAddsViewerGrids) {
 
     openvdb::MetaMap::Ptr file_meta;
     const openvdb::GridPtrVec grids = ReadGrids(dir / "map.vdb", &file_meta);
-    ASSERT_EQ(grids.size(), 6u);
+    ASSERT_EQ(grids.size(), 7u);
     const auto occupancy = Find<openvdb::FloatGrid>(grids, "occupancy");
     const auto label = Find<openvdb::Int32Grid>(grids, "label");
     const auto label_weight = Find<openvdb::FloatGrid>(grids, "label_weight");
     const auto hits = Find<openvdb::Int32Grid>(grids, "hits");
+    const auto point_mean = Find<openvdb::Vec3SGrid>(grids, "point_mean");
     const auto density = Find<openvdb::FloatGrid>(grids, "density");
     const auto color = Find<openvdb::Vec3SGrid>(grids, "color");
-    ASSERT_TRUE(occupancy && label && label_weight && hits && density && color);
+    ASSERT_TRUE(occupancy && label && label_weight && hits && point_mean && density && color);
     ExpectSameGrid(*map.occupancy, *occupancy);
     ExpectSameGrid(*map.label, *label);
     ExpectSameGrid(*map.label_weight, *label_weight);
@@ -146,7 +147,7 @@ TEST(VdbExport, OptionsLeaveOutViewerGrids) {
     options.include_color = false;
     WriteVdb(MakeExportTestMap(), dir / "map.vdb", options);
     const openvdb::GridPtrVec grids = ReadGrids(dir / "map.vdb");
-    EXPECT_EQ(grids.size(), 4u);
+    EXPECT_EQ(grids.size(), 5u);
     EXPECT_FALSE(Find<openvdb::FloatGrid>(grids, "density"));
 }
 
@@ -157,7 +158,7 @@ TEST(VdbExport, VdbPrintListsEveryGrid) {
     // vdb_print exits 0 even when it cannot read a file, so check what it printed.
     const std::string out =
         RunCommand("/usr/bin/vdb_print -l '" + (dir / "map.vdb").string() + "' 2>&1");
-    for (const char* name : {"occupancy", "label", "label_weight", "hits", "density", "color"}) {
+    for (const char* name : {"occupancy", "label", "label_weight", "hits", "point_mean", "density", "color"}) {
         EXPECT_NE(out.find(name), std::string::npos) << name << " missing in:\n" << out;
     }
     EXPECT_NE(out.find("vec3s"), std::string::npos) << out;

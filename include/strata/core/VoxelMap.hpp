@@ -14,6 +14,7 @@ inline constexpr const char* kOccupancy = "occupancy";      ///< FloatGrid, log-
 inline constexpr const char* kLabel = "label";              ///< Int32Grid, SemanticClass
 inline constexpr const char* kLabelWeight = "label_weight";  ///< FloatGrid, vote weight
 inline constexpr const char* kHits = "hits";                ///< Int32Grid, endpoint count
+inline constexpr const char* kPointMean = "point_mean";     ///< Vec3SGrid, mean endpoint offset
 }  // namespace grid_names
 
 /// @brief The aligned bundle of per-voxel grids that make a map. All grids share one transform:
@@ -27,6 +28,11 @@ struct VoxelMap {
     openvdb::Int32Grid::Ptr label;
     openvdb::FloatGrid::Ptr label_weight;
     openvdb::Int32Grid::Ptr hits;
+    /// Mean position of the endpoints in each voxel, as an offset in metres from the voxel's
+    /// centre (|offset| <= s/2 per axis); active where `hits` is. Planes fitted to these are not
+    /// limited by the voxel size (NDT maps keep the same). Maps written before this grid existed
+    /// read back with it empty: consumers fall back to the centre where it is inactive.
+    openvdb::Vec3SGrid::Ptr point_mean;
 
     /// @brief An empty map; throws std::invalid_argument unless 0 < voxel_size_m.
     [[nodiscard]] static VoxelMap Create(double voxel_size_m,
@@ -43,6 +49,8 @@ struct VoxelMap {
     [[nodiscard]] openvdb::Coord WorldToVoxel(const Eigen::Vector3d& p_map) const;
     /// @brief Centre of a voxel in the map frame.
     [[nodiscard]] Eigen::Vector3d VoxelCenter(const openvdb::Coord& ijk) const;
+    /// @brief Where the endpoints of a voxel lay: centre plus `point_mean` (centre when unknown).
+    [[nodiscard]] Eigen::Vector3d PointMean(const openvdb::Coord& ijk) const;
 };
 
 /// @brief Log-odds and probability helpers shared by integration and exports.

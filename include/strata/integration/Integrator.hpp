@@ -16,6 +16,8 @@ struct EndpointGroup {
     openvdb::Coord ijk;
     int32_t points = 0;
     core::SemanticClass label = core::SemanticClass::kUnknown;
+    /// Sum over the group's points of (point - voxel centre), metres.
+    Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
 };
 
 /// @brief What one scan observed, before it touches a map (ARCHITECTURE.md, "Integration
@@ -36,7 +38,8 @@ struct ScanUpdate {
                                            const IntegrationConfig& config);
 
 /// @brief Applies an update: log-odds miss on free voxels, hit on occupied ones (clamped),
-/// endpoint counts into `hits`, label votes into `label` / `label_weight`.
+/// endpoint counts into `hits`, the running mean of endpoint positions into `point_mean`, label
+/// votes into `label` / `label_weight`.
 void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
                      const IntegrationConfig& config);
 
