@@ -65,6 +65,16 @@ void DrawText(RgbImage& image, int x0, int y0, const std::string& text, int scal
     }
 }
 
+}  // namespace
+
+void DrawLabel(RgbImage& image, int x, int y, const std::string& text, int scale) {
+    DrawText(image, x, y, text, scale);
+}
+
+int LabelWidth(const std::string& text, int scale) { return TextWidth(text, scale); }
+
+namespace {
+
 // "0.5 m", "20 m", "1000 m": the decimal text of mantissa * 10^exponent metres.
 std::string LengthLabel(int mantissa, int exponent) {
     if (exponent >= 0) {

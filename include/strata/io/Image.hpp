@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "strata/core/Labels.hpp"
@@ -42,6 +43,13 @@ private:
 /// (1, 2 or 5 x 10^k m) about a quarter of the image wide. Does nothing on images too small for it.
 /// @param meters_per_pixel ground size of one pixel; must be positive.
 void DrawScaleBar(RgbImage& image, double meters_per_pixel);
+
+/// @brief Draws white text in a 5-pixel-high bitmap font scaled by `scale` with its top-left
+/// corner at (x, y), clipped to the image. The font has digits, '.', ' ' and 'm' only (labels
+/// of scale bars and legends); other characters draw as blanks.
+void DrawLabel(RgbImage& image, int x, int y, const std::string& text, int scale = 2);
+/// @brief Width in pixels DrawLabel needs for `text`.
+[[nodiscard]] int LabelWidth(const std::string& text, int scale = 2);
 
 /// @brief Writes an 8-bit RGB PNG, all or nothing (temporary file + rename).
 /// @note Throws std::runtime_error naming `path` on any I/O problem, std::invalid_argument for an

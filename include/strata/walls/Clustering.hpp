@@ -1,0 +1,33 @@
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace strata::walls {
+
+/// Label of a point DBSCAN left unclustered.
+inline constexpr int kNoise = -1;
+
+/// @brief DBSCAN (Ester et al. 1996) on voxels, with the voxel grid itself as the neighbour
+/// index: the neighbours of a voxel are the voxels of the set within `eps_voxels` (Euclidean,
+/// in voxel units). A voxel with at least `min_points` neighbours (itself included) is a core
+/// voxel; clusters are core voxels linked through each other plus the border voxels they reach.
+/// @return one label per voxel: 0, 1, ... in order of first appearance, or kNoise.
+/// @throw std::invalid_argument unless eps_voxels >= 1 and min_points >= 1.
+[[nodiscard]] std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
+                                      int min_points);
+
+/// @brief Lloyd's K-means with k-means++ seeding (deterministic for a seed). k is clamped to
+/// [1, points.size()].
+/// @return one cluster index in [0, k) per point; empty for no points.
+[[nodiscard]] std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k,
+                                      uint64_t seed = 1, int max_iterations = 50);
+
+/// @brief The study's rule for the number of K-means parts of a cluster: floor(n / divisor),
+/// at least 1.
+[[nodiscard]] int PartsFor(size_t n, int divisor);
+
+}  // namespace strata::walls

@@ -1,0 +1,137 @@
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "strata/columns/ColumnStats.hpp"
+#include "strata/core/VoxelMap.hpp"
+#include "strata/walls/PlaneFit.hpp"
+
+namespace strata::walls {
+
+/// @brief Settings of the wall pipeline (docs/walls.md explains each stage and default).
+struct WallConfig {
+    // 1. Column statistics and voting.
+    double window_m = 1.0;  ///< side of the sliding x/y window (rounded to an odd voxel count)
+    /// A window votes for walls when it holds at least this much occupied surface per metre of
+    /// window side (occupied voxels x voxel area / window side, m^2/m: a vertical wall of height
+    /// h crossing the window gives h) and its occupied voxels span at least this height. Counting
+    /// voxels rather than points makes the vote independent of point density and range, as long
+    /// as the scanner puts a point into each surface voxel.
+    double min_wall_height_m = 2.0;
+    /// The study's rule, optionally on top: at least this many points (`hits`) per window
+    /// (500 for its backpack scanner and 1 m windows); 0 = off.
+    int64_t min_window_points = 0;
+    /// Candidate voxels start this far above the lowest occupied voxel of their window (ground).
+    double ground_clearance_m = 0.4;
+
+    // 2. Clustering.
+    double dbscan_eps_voxels = 2.0;  ///< neighbour radius of DBSCAN, in voxels
+    int dbscan_min_points = 6;       ///< neighbours (itself included) that make a core voxel
+    int kmeans_divisor = 400;        ///< K-means parts per cluster: k = floor(n / divisor)
+
+    // 3. Per part: RANSAC plane and the wall tests.
+    double ransac_threshold_m = 0.0;  ///< inlier distance; 0 = half a voxel
+    int ransac_iterations = 200;
+    size_t min_part_voxels = 30;        ///< smaller parts are dropped as clutter
+    double min_inlier_fraction = 0.45;  ///< a part's voxels on its plane
+    double min_eigen_ratio = 1.7;       ///< x/y eigenvalue ratio of the inliers (the study's 1.7)
+    double min_slant_deg = 60.0;        ///< flatter planes (ground, roofs) are not walls
+    double min_part_height_m = 1.5;     ///< vertical extent of a part's inliers
+    double min_part_length_m = 1.0;     ///< horizontal extent along the plane (tree trunks fail)
+
+    // 4. Walls: coplanar accepted parts merge, then one refined fit per wall.
+    double merge_angle_deg = 10.0;  ///< two parts merge when their normals are this close, ...
+    double merge_gap_m = 1.0;       ///< ... the boxes of their inliers this close, and ...
+    /// ... one part's plane holds this fraction as many of the other's voxels as its own plane
+    /// does (so a part whose own fit went astray still joins the wall it lies on).
+    double merge_support = 0.7;
+    bool refine = true;              ///< Ceres refinement with a Cauchy loss
+    double min_wall_length_m = 1.0;  ///< horizontal extent of a wall's inliers
+    uint64_t seed = 1;               ///< RANSAC and K-means seeds (results are deterministic)
+
+    /// @brief Throws std::invalid_argument naming the first bad field.
+    void Validate() const;
+};
+
+/// @brief One wall: a plane fitted to the voxels (their centres) of one or more parts.
+struct Wall {
+    int id = 0;                                          ///< 1, 2, ... by decreasing inlier count
+    double slant_deg = 90.0;                             ///< SlantDeg(normal): 90 = vertical
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the inliers, map frame
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitX();   ///< unit, towards the observed side
+    double d = 0.0;                                      ///< plane: normal . x + d = 0
+    size_t inliers = 0;                  ///< voxels within the RANSAC threshold of the plane
+    double area_m2 = 0.0;                ///< surface the inlier voxels cover
+    double rms_m = 0.0;                  ///< of the inliers' distances to the plane
+    double uncertainty_deg = 0.0;        ///< one-sigma slant uncertainty of the fit
+    double lean_azimuth_deg = 0.0;       ///< LeanAzimuthDeg(normal)
+    double length_m = 0.0;               ///< horizontal extent of the inliers along the wall
+    double height_m = 0.0;               ///< vertical extent of the inliers
+    double eigen_ratio = 0.0;            ///< x/y eigenvalue ratio of the inliers
+    int parts = 0;                       ///< K-means parts merged into this wall
+    std::vector<openvdb::Coord> voxels;  ///< the inlier voxels
+};
+
+/// @brief Why a K-means part was or was not taken as (a piece of) a wall.
+enum class PartVerdict {
+    kWall,
+    kTooSmall,
+    kNotPlanar,
+    kNotLineLike,
+    kNotSteep,
+    kTooLow,
+    kTooNarrow,
+};
+[[nodiscard]] const char* VerdictName(PartVerdict v);
+
+/// @brief One K-means part, for diagnostics and tests.
+struct WallPart {
+    int cluster = 0;
+    size_t voxels = 0;
+    size_t inliers = 0;
+    double eigen_ratio = 0.0;
+    double slant_deg = 0.0;
+    double height_m = 0.0;
+    double length_m = 0.0;  ///< horizontal extent of the inliers along the plane
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    /// Most frequent fused class of its voxels (kUnknown on maps without labels).
+    core::SemanticClass dominant_class = core::SemanticClass::kUnknown;
+    PartVerdict verdict = PartVerdict::kTooSmall;
+};
+
+/// @brief Counts of each stage, and where the time went.
+struct WallStats {
+    size_t occupied_columns = 0;
+    size_t voting_columns = 0;
+    size_t candidate_voxels = 0;
+    size_t clusters = 0;
+    size_t noise_voxels = 0;  ///< candidates DBSCAN left unclustered
+    double seconds_columns = 0.0, seconds_clustering = 0.0, seconds_fitting = 0.0;
+};
+
+struct WallResult {
+    std::vector<Wall> walls;
+    std::vector<WallPart> parts;
+    WallStats stats;
+    double voxel_size = 0.0;
+};
+
+/// @brief Stage 1 (voting): the occupied voxels of the columns whose window votes for walls,
+/// minus the ground at the bottom of the window. `window` is columns.Window(radius).
+[[nodiscard]] std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
+                                                         const columns::ColumnGrid& window,
+                                                         int radius, const WallConfig& config,
+                                                         size_t* voting_columns = nullptr);
+
+/// @brief The whole pipeline on a map (ARCHITECTURE.md, "Walls and slant angles"): column
+/// statistics, voting, DBSCAN, K-means, RANSAC + wall tests per part, merge, SVD + Ceres per
+/// wall. Uses one thread. Throws std::invalid_argument for a bad config or a map without
+/// occupancy.
+[[nodiscard]] WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config = {});
+
+}  // namespace strata::walls

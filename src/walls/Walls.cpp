@@ -1,0 +1,413 @@
+#include "strata/walls/Walls.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "strata/walls/Clustering.hpp"
+
+namespace strata::walls {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+    return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+void Require(bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("wall config: ") + what);
+}
+
+// An accepted part, before merging.
+struct Piece {
+    int cluster = 0;
+    Plane plane;
+    Eigen::Vector3d centroid;
+    Eigen::Vector3d lo, hi;               // box of the inliers
+    std::vector<openvdb::Coord> voxels;   // every voxel of the part
+    std::vector<Eigen::Vector3d> points;  // their endpoint means
+    size_t inliers = 0;                   // points within the threshold of `plane`
+};
+
+// How many of b's points a's plane holds, relative to b's own plane.
+double Support(const Piece& a, const Piece& b, double threshold) {
+    size_t on = 0;
+    for (const auto& p : b.points) on += std::abs(a.plane.Distance(p)) <= threshold;
+    return b.inliers ? static_cast<double>(on) / static_cast<double>(b.inliers) : 0.0;
+}
+
+struct UnionFind {
+    std::vector<int> parent;
+    explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+    int Find(int a) {
+        while (parent[a] != a) a = parent[a] = parent[parent[a]];
+        return a;
+    }
+    void Join(int a, int b) { parent[Find(a)] = Find(b); }
+};
+
+double BoxGap(const Piece& a, const Piece& b) {
+    const Eigen::Vector3d gap =
+        (a.lo - b.hi).cwiseMax(b.lo - a.hi).cwiseMax(Eigen::Vector3d::Zero());
+    return gap.norm();
+}
+
+// Orients a wall normal towards the side the scanner saw: of the voxels two voxels in front of
+// and behind a sample of inliers, the side with more observed-free voxels is the front.
+Eigen::Vector3d TowardsObservedSide(const core::VoxelMap& map,
+                                    const std::vector<openvdb::Coord>& voxels,
+                                    const Eigen::Vector3d& normal) {
+    auto occupancy = map.occupancy->getConstAccessor();
+    const size_t step = std::max<size_t>(1, voxels.size() / 256);
+    int front = 0, back = 0;
+    auto free_at = [&](const Eigen::Vector3d& p) {
+        const openvdb::Coord c = map.WorldToVoxel(p);
+        float value = 0.0f;
+        return occupancy.probeValue(c, value) && value <= 0.0f;
+    };
+    for (size_t n = 0; n < voxels.size(); n += step) {
+        const Eigen::Vector3d p = map.PointMean(voxels[n]);
+        front += free_at(p + 2.0 * map.voxel_size * normal);
+        back += free_at(p - 2.0 * map.voxel_size * normal);
+    }
+    return back > front ? Eigen::Vector3d(-normal) : normal;
+}
+
+// Extent of points along the horizontal direction of a plane with this normal.
+double HorizontalExtent(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& normal) {
+    const Eigen::Vector3d along = Eigen::Vector3d::UnitZ().cross(normal);
+    if (points.empty() || along.norm() < 1e-9) return 0.0;
+    double lo = 1e300, hi = -1e300;
+    for (const auto& p : points) {
+        lo = std::min(lo, p.dot(along.normalized()));
+        hi = std::max(hi, p.dot(along.normalized()));
+    }
+    return hi - lo;
+}
+
+// Adds to `voxels` their 26-neighbours that hold endpoints (hits) but are not in the set.
+void AddHitNeighbours(const core::VoxelMap& map, std::vector<openvdb::Coord>& voxels) {
+    openvdb::BoolGrid::Ptr in = openvdb::BoolGrid::create(false);
+    auto member = in->getAccessor();
+    for (const auto& c : voxels) member.setValueOn(c, true);
+    auto hits = map.hits->getConstAccessor();
+    const size_t n = voxels.size();
+    for (size_t i = 0; i < n; ++i) {
+        for (int dz = -1; dz <= 1; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const openvdb::Coord q = voxels[i].offsetBy(dx, dy, dz);
+                    if (member.isValueOn(q) || hits.getValue(q) <= 0) continue;
+                    member.setValueOn(q, true);
+                    voxels.push_back(q);
+                }
+            }
+        }
+    }
+}
+
+core::SemanticClass DominantClass(const core::VoxelMap& map,
+                                  const std::vector<openvdb::Coord>& voxels) {
+    if (!map.label) return core::SemanticClass::kUnknown;
+    std::array<size_t, core::kNumClasses> counts{};
+    auto label = map.label->getConstAccessor();
+    for (const auto& c : voxels) {
+        const int l = label.getValue(c);
+        if (l >= 0 && l < core::kNumClasses) ++counts[static_cast<size_t>(l)];
+    }
+    const auto best = std::max_element(counts.begin(), counts.end());
+    return static_cast<core::SemanticClass>(best - counts.begin());
+}
+
+}  // namespace
+
+const char* VerdictName(PartVerdict v) {
+    switch (v) {
+        case PartVerdict::kWall:
+            return "wall";
+        case PartVerdict::kTooSmall:
+            return "too_small";
+        case PartVerdict::kNotPlanar:
+            return "not_planar";
+        case PartVerdict::kNotLineLike:
+            return "not_line_like";
+        case PartVerdict::kNotSteep:
+            return "not_steep";
+        case PartVerdict::kTooLow:
+            return "too_low";
+        case PartVerdict::kTooNarrow:
+            return "too_narrow";
+    }
+    return "unknown";
+}
+
+void WallConfig::Validate() const {
+    Require(window_m > 0.0, "window_m must be > 0");
+    Require(min_wall_height_m >= 0.0, "min_wall_height_m must be >= 0");
+    Require(min_window_points >= 0, "min_window_points must be >= 0");
+    Require(ground_clearance_m >= 0.0, "ground_clearance_m must be >= 0");
+    Require(dbscan_eps_voxels >= 1.0, "dbscan_eps_voxels must be >= 1");
+    Require(dbscan_min_points >= 1, "dbscan_min_points must be >= 1");
+    Require(kmeans_divisor >= 1, "kmeans_divisor must be >= 1");
+    Require(ransac_threshold_m >= 0.0, "ransac_threshold_m must be >= 0");
+    Require(ransac_iterations >= 1, "ransac_iterations must be >= 1");
+    Require(min_part_voxels >= 3, "min_part_voxels must be >= 3");
+    Require(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0,
+            "min_inlier_fraction must be in [0, 1]");
+    Require(min_eigen_ratio >= 1.0, "min_eigen_ratio must be >= 1");
+    Require(min_slant_deg >= 0.0 && min_slant_deg <= 90.0, "min_slant_deg must be in [0, 90]");
+    Require(min_part_height_m >= 0.0, "min_part_height_m must be >= 0");
+    Require(min_part_length_m >= 0.0, "min_part_length_m must be >= 0");
+    Require(merge_angle_deg >= 0.0 && merge_angle_deg <= 90.0,
+            "merge_angle_deg must be in [0, 90]");
+    Require(merge_gap_m >= 0.0, "merge_gap_m must be >= 0");
+    Require(merge_support >= 0.0 && merge_support <= 1.0, "merge_support must be in [0, 1]");
+    Require(min_wall_length_m >= 0.0, "min_wall_length_m must be >= 0");
+}
+
+std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
+                                           const columns::ColumnGrid& window, int radius,
+                                           const WallConfig& config, size_t* voting_columns) {
+    const double s = map.voxel_size;
+    const double side_m = (2 * radius + 1) * s;
+    const int clearance = static_cast<int>(std::ceil(config.ground_clearance_m / s - 1e-9));
+    auto votes = [&](const columns::ColumnStat& w) {
+        return w.voxels > 0 && w.voxels * s * s / side_m >= config.min_wall_height_m &&
+               w.extent_voxels() * s >= config.min_wall_height_m &&
+               w.points >= config.min_window_points;
+    };
+    if (voting_columns) {
+        *voting_columns = 0;
+        for (int j = window.min_j(); j < window.min_j() + window.height(); ++j) {
+            for (int i = window.min_i(); i < window.min_i() + window.width(); ++i) {
+                *voting_columns += votes(window.At(i, j));
+            }
+        }
+    }
+    std::vector<openvdb::Coord> candidates;
+    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.0f) continue;
+        openvdb::CoordBBox box;
+        it.getBoundingBox(box);
+        for (auto v = box.begin(); v; ++v) {
+            const openvdb::Coord& ijk = *v;
+            const columns::ColumnStat& w = window.At(ijk.x(), ijk.y());
+            if (votes(w) && ijk.z() >= w.k_min + clearance) candidates.push_back(ijk);
+        }
+    }
+    return candidates;
+}
+
+WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
+    config.Validate();
+    if (!map.occupancy) throw std::invalid_argument("walls: the map has no occupancy grid");
+    WallResult result;
+    const double s = map.voxel_size;
+    result.voxel_size = s;
+    const double threshold = config.ransac_threshold_m > 0.0 ? config.ransac_threshold_m : 0.5 * s;
+
+    // 1. Columns and votes.
+    auto t = Clock::now();
+    const int radius = std::max(0, static_cast<int>(std::lround(config.window_m / s / 2.0 - 0.5)));
+    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(map);
+    result.stats.occupied_columns = cols.OccupiedColumns();
+    const columns::ColumnGrid window = cols.Window(radius);
+    const std::vector<openvdb::Coord> candidates =
+        VoteCandidates(map, window, radius, config, &result.stats.voting_columns);
+    result.stats.candidate_voxels = candidates.size();
+    result.stats.seconds_columns = Seconds(t);
+
+    // 2. DBSCAN, then K-means inside each cluster.
+    t = Clock::now();
+    const std::vector<int> cluster_of =
+        Dbscan(candidates, config.dbscan_eps_voxels, config.dbscan_min_points);
+    int clusters = 0;
+    for (int c : cluster_of) clusters = std::max(clusters, c + 1);
+    result.stats.clusters = static_cast<size_t>(clusters);
+    std::vector<std::vector<openvdb::Coord>> members(static_cast<size_t>(clusters));
+    for (size_t n = 0; n < candidates.size(); ++n) {
+        if (cluster_of[n] == kNoise) {
+            ++result.stats.noise_voxels;
+        } else {
+            members[cluster_of[n]].push_back(candidates[n]);
+        }
+    }
+    struct PartVoxels {
+        int cluster;
+        std::vector<openvdb::Coord> voxels;
+    };
+    std::vector<PartVoxels> parts;
+    for (int c = 0; c < clusters; ++c) {
+        const auto& voxels = members[c];
+        std::vector<Eigen::Vector3d> points(voxels.size());
+        for (size_t n = 0; n < voxels.size(); ++n) points[n] = map.PointMean(voxels[n]);
+        const int k = PartsFor(voxels.size(), config.kmeans_divisor);
+        const std::vector<int> part_of = KMeans(points, k, config.seed + c);
+        std::vector<PartVoxels> local(static_cast<size_t>(k), PartVoxels{c, {}});
+        for (size_t n = 0; n < voxels.size(); ++n) local[part_of[n]].voxels.push_back(voxels[n]);
+        for (auto& p : local) {
+            if (!p.voxels.empty()) parts.push_back(std::move(p));
+        }
+    }
+    result.stats.seconds_clustering = Seconds(t);
+
+    // 3. Per part: RANSAC, then the wall tests on the inliers.
+    t = Clock::now();
+    std::vector<Piece> pieces;
+    for (size_t p = 0; p < parts.size(); ++p) {
+        const auto& voxels = parts[p].voxels;
+        WallPart part;
+        part.cluster = parts[p].cluster;
+        part.voxels = voxels.size();
+        part.dominant_class = DominantClass(map, voxels);
+        std::vector<Eigen::Vector3d> points(voxels.size());
+        for (size_t n = 0; n < voxels.size(); ++n) points[n] = map.PointMean(voxels[n]);
+        if (voxels.size() < config.min_part_voxels) {
+            part.verdict = PartVerdict::kTooSmall;
+            result.parts.push_back(part);
+            continue;
+        }
+        const RansacResult ransac =
+            RansacPlane(points, threshold, config.ransac_iterations, config.seed + p);
+        std::vector<Eigen::Vector3d> inliers;
+        inliers.reserve(ransac.inliers);
+        Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+        for (size_t n = 0; n < points.size(); ++n) {
+            if (!ransac.inlier[n]) continue;
+            inliers.push_back(points[n]);
+            lo = lo.cwiseMin(points[n]);
+            hi = hi.cwiseMax(points[n]);
+        }
+        part.inliers = inliers.size();
+        part.eigen_ratio = XyEigenRatio(inliers);
+        part.slant_deg = SlantDeg(ransac.plane.normal);
+        part.height_m = inliers.empty() ? 0.0 : hi.z() - lo.z() + s;
+        part.length_m = HorizontalExtent(inliers, ransac.plane.normal) + s;
+        for (const auto& q : inliers) part.centroid += q;
+        if (!inliers.empty()) part.centroid /= static_cast<double>(inliers.size());
+        if (inliers.size() < config.min_inlier_fraction * static_cast<double>(points.size()) ||
+            inliers.size() < 3) {
+            part.verdict = PartVerdict::kNotPlanar;
+        } else if (part.slant_deg < config.min_slant_deg) {
+            part.verdict = PartVerdict::kNotSteep;
+        } else if (part.eigen_ratio < config.min_eigen_ratio) {
+            part.verdict = PartVerdict::kNotLineLike;
+        } else if (part.height_m < config.min_part_height_m) {
+            part.verdict = PartVerdict::kTooLow;
+        } else if (part.length_m < config.min_part_length_m) {
+            part.verdict = PartVerdict::kTooNarrow;
+        } else {
+            part.verdict = PartVerdict::kWall;
+            // Merging compares planes, so each piece gets the robust fit too: a RANSAC plane of
+            // a facade with deep windows can be off by degrees.
+            Piece piece{part.cluster, ransac.plane, part.centroid, lo, hi, voxels, points, 0};
+            if (config.refine) piece.plane = RefinePlane(inliers, ransac.plane, 0.25 * threshold);
+            for (const auto& q : points)
+                piece.inliers += std::abs(piece.plane.Distance(q)) <= threshold;
+            pieces.push_back(std::move(piece));
+        }
+        result.parts.push_back(part);
+    }
+
+    // 4. Merge coplanar neighbouring pieces, then fit each wall once on all its voxels.
+    UnionFind groups(pieces.size());
+    const double cos_merge = std::cos(config.merge_angle_deg * M_PI / 180.0);
+    for (size_t a = 0; a < pieces.size(); ++a) {
+        for (size_t b = a + 1; b < pieces.size(); ++b) {
+            const Piece& pa = pieces[a];
+            const Piece& pb = pieces[b];
+            if (std::abs(pa.plane.normal.dot(pb.plane.normal)) < cos_merge) continue;
+            if (BoxGap(pa, pb) > config.merge_gap_m) continue;
+            if (std::max(Support(pa, pb, threshold), Support(pb, pa, threshold)) <
+                config.merge_support) {
+                continue;
+            }
+            groups.Join(static_cast<int>(a), static_cast<int>(b));
+        }
+    }
+    auto hits = map.hits->getConstAccessor();
+    std::vector<std::vector<size_t>> members_of(pieces.size());
+    for (size_t a = 0; a < pieces.size(); ++a)
+        members_of[groups.Find(static_cast<int>(a))].push_back(a);
+    for (const auto& group : members_of) {
+        if (group.empty()) continue;
+        // One plane for the whole wall: RANSAC on all its parts' voxels (a part's own plane may
+        // be off), then the weighted robust fit below.
+        std::vector<openvdb::Coord> voxels;
+        std::vector<Eigen::Vector3d> points;
+        for (size_t a : group) {
+            voxels.insert(voxels.end(), pieces[a].voxels.begin(), pieces[a].voxels.end());
+            points.insert(points.end(), pieces[a].points.begin(), pieces[a].points.end());
+        }
+        Plane plane =
+            RansacPlane(points, threshold, config.ransac_iterations, config.seed + group[0]).plane;
+        // A noisy point lands in the voxel in front of the surface now and then, and that voxel,
+        // crossed by many rays, usually ends up free: keeping only occupied voxels would drop
+        // those points and pull each mean backwards by an amount that changes with the height
+        // of the surface inside its voxel, i.e. tilt the plane. So the fit also takes the
+        // endpoint voxels next to the group that are not occupied, each weighed by its count.
+        AddHitNeighbours(map, voxels);
+        std::vector<Eigen::Vector3d> near;
+        std::vector<double> weights;
+        for (const auto& c : voxels) {
+            const Eigen::Vector3d p = map.PointMean(c);
+            if (std::abs(plane.Distance(p)) > threshold) continue;
+            near.push_back(p);
+            weights.push_back(std::max(1, hits.getValue(c)));
+        }
+        if (near.size() < 3) continue;
+        plane = config.refine ? RefinePlane(near, plane, 0.25 * threshold, weights)
+                              : FitPlane(near, weights).plane;
+        Wall wall;
+        std::vector<Eigen::Vector3d> final_points;
+        for (const auto& c : voxels) {
+            const Eigen::Vector3d p = map.PointMean(c);
+            if (std::abs(plane.Distance(p)) <= threshold) {
+                final_points.push_back(p);
+                wall.voxels.push_back(c);
+            }
+        }
+        if (final_points.size() < 3) continue;
+        PlaneFit fit = FitPlane(final_points);
+        double sum2 = 0.0;
+        for (const auto& p : final_points) sum2 += plane.Distance(p) * plane.Distance(p);
+        fit.plane = plane;
+        fit.rms = std::sqrt(sum2 / static_cast<double>(final_points.size()));
+        wall.normal = TowardsObservedSide(map, wall.voxels, plane.normal);
+        wall.d = wall.normal.dot(plane.normal) > 0 ? plane.d : -plane.d;
+        wall.centroid = fit.centroid;
+        wall.inliers = final_points.size();
+        wall.rms_m = fit.rms;
+        wall.slant_deg = SlantDeg(wall.normal);
+        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal);
+        wall.uncertainty_deg = SlantUncertaintyDeg(fit);
+        wall.eigen_ratio = XyEigenRatio(final_points);
+        wall.parts = static_cast<int>(group.size());
+        // A plane crosses about (|nx| + |ny| + |nz|) voxels per voxel face of its area.
+        wall.area_m2 = static_cast<double>(wall.inliers) * s * s / wall.normal.cwiseAbs().sum();
+        const Eigen::Vector3d along = Eigen::Vector3d::UnitZ().cross(wall.normal).normalized();
+        const Eigen::Vector3d up = wall.normal.cross(along).normalized();
+        double a_lo = 1e300, a_hi = -1e300, z_lo = 1e300, z_hi = -1e300;
+        for (const auto& p : final_points) {
+            a_lo = std::min(a_lo, p.dot(along));
+            a_hi = std::max(a_hi, p.dot(along));
+            z_lo = std::min(z_lo, p.dot(up));
+            z_hi = std::max(z_hi, p.dot(up));
+        }
+        wall.length_m = a_hi - a_lo + s;
+        wall.height_m = z_hi - z_lo + s;
+        if (wall.length_m < config.min_wall_length_m) continue;
+        result.walls.push_back(std::move(wall));
+    }
+    std::sort(result.walls.begin(), result.walls.end(),
+              [](const Wall& a, const Wall& b) { return a.inliers > b.inliers; });
+    for (size_t w = 0; w < result.walls.size(); ++w) result.walls[w].id = static_cast<int>(w + 1);
+    result.stats.seconds_fitting = Seconds(t);
+    return result;
+}
+
+}  // namespace strata::walls
