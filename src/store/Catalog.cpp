@@ -110,6 +110,39 @@ CREATE TABLE change_sets (
   report         TEXT NOT NULL
 );
 )sql",
+    // 2 -> 3: analyses commit their products (kinds 'walls', 'vehicles'); the walls table gets the
+    // columns `strata walls` reports. Neither table had rows of these kinds before, so walls is
+    // replaced and commits is rebuilt with the wider CHECK (SQLite cannot alter a CHECK).
+    R"sql(
+CREATE TABLE commits_v3 (
+  id         INTEGER PRIMARY KEY AUTOINCREMENT,
+  time_utc   TEXT NOT NULL,
+  session_id INTEGER,
+  kind       TEXT NOT NULL
+             CHECK (kind IN ('create', 'integrate', 'remove_session', 'walls', 'vehicles'))
+);
+INSERT INTO commits_v3(id, time_utc, session_id, kind)
+  SELECT id, time_utc, session_id, kind FROM commits;
+DROP TABLE commits;
+ALTER TABLE commits_v3 RENAME TO commits;
+DROP TABLE walls;
+CREATE TABLE walls (
+  id               INTEGER PRIMARY KEY AUTOINCREMENT,
+  commit_id        INTEGER NOT NULL REFERENCES commits(id),
+  wall_id          INTEGER NOT NULL,
+  center_x REAL NOT NULL, center_y REAL NOT NULL, center_z REAL NOT NULL,
+  normal_x REAL NOT NULL, normal_y REAL NOT NULL, normal_z REAL NOT NULL,
+  slant_deg        REAL NOT NULL,
+  uncertainty_deg  REAL NOT NULL,
+  lean_azimuth_deg REAL NOT NULL,
+  area_m2          REAL NOT NULL,
+  rms_m            REAL NOT NULL,
+  length_m         REAL NOT NULL,
+  height_m         REAL NOT NULL,
+  inliers          INTEGER NOT NULL
+);
+CREATE INDEX walls_by_commit ON walls(commit_id);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == MapStore::kFormatVersion, "one migration per format version");

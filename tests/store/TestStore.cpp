@@ -2,13 +2,14 @@
 // on synthetic scans whose in-memory integration is the known answer.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
-#include <atomic>
 #include <random>
-#include <thread>
 #include <set>
+#include <thread>
 
 #include "MapDiff.hpp"
 #include "strata/integration/Integrator.hpp"
@@ -46,8 +47,9 @@ Scan RoomScan(uint32_t seed, const Eigen::Vector3d& centre, size_t n = 6000) {
         const Eigen::Array3d half(6.0, 4.0, 1.5);
         const double t = (half / d.array().abs()).minCoeff();
         scan.points.push_back(d * t);
-        scan.labels.push_back(std::abs(d.z() * t + 1.5) < 1e-9 ? strata::core::SemanticClass::kGround
-                                                                : strata::core::SemanticClass::kBuilding);
+        scan.labels.push_back(std::abs(d.z() * t + 1.5) < 1e-9
+                                  ? strata::core::SemanticClass::kGround
+                                  : strata::core::SemanticClass::kBuilding);
     }
     scan.source = "room_" + std::to_string(seed);
     scan.time_s = seed * 0.1;
@@ -104,7 +106,8 @@ void ExpectSameMap(const VoxelMap& a, const VoxelMap& b) {
         if (std::string(e.what()).find(what) != std::string::npos) {
             return ::testing::AssertionSuccess();
         }
-        return ::testing::AssertionFailure() << "message '" << e.what() << "' lacks '" << what << "'";
+        return ::testing::AssertionFailure()
+               << "message '" << e.what() << "' lacks '" << what << "'";
     }
     return ::testing::AssertionFailure() << "no exception";
 }
@@ -124,8 +127,9 @@ TEST(Store, CreateRecordsSettingsAndRefusesToOverwrite) {
     EXPECT_EQ(map.settings().format_version, MapStore::kFormatVersion);
     EXPECT_EQ(map.Latest().sessions.size(), 0u);
     EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Create(dir, settings); }, dir.string()));
-    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(Temp("nothing"), MapStore::Access::kRead); },
-                             "no such map directory"));
+    EXPECT_TRUE(
+        ThrowsNaming([&] { (void)MapStore::Open(Temp("nothing"), MapStore::Access::kRead); },
+                     "no such map directory"));
     const fs::path empty = Temp("empty");
     fs::create_directories(empty);
     EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(empty, MapStore::Access::kRead); },
@@ -213,8 +217,8 @@ TEST(Store, SessionLayersSayWhatEachSessionSaw) {
         const strata::store::Tile tile = map.ReadTile(version);
         ASSERT_FALSE(tile.layers.empty());
         for (const auto& layer : tile.layers) {
-            EXPECT_EQ(layer.occupied->getName(), "session_" + std::to_string(layer.session) +
-                                                     "_occupied");
+            EXPECT_EQ(layer.occupied->getName(),
+                      "session_" + std::to_string(layer.session) + "_occupied");
             // Disjoint, and inside what the fused map observed.
             auto free = layer.free->getConstAccessor();
             auto fused = tile.fused.occupancy->getConstAccessor();
@@ -335,9 +339,8 @@ TEST(Store, OneWriterAtATimeAndReadersKeepTheirSnapshot) {
 
 TEST(Store, ReadersSeeWholeCommitsWhileAWriterCommits) {
     const fs::path dir = Temp("concurrent");
-    const std::vector<std::vector<Scan>> sessions = {Session(1, {0, 0, 0}, 2),
-                                                     Session(10, {3, 1, 0}, 2),
-                                                     Session(20, {-2, -1, 0}, 2)};
+    const std::vector<std::vector<Scan>> sessions = {
+        Session(1, {0, 0, 0}, 2), Session(10, {3, 1, 0}, 2), Session(20, {-2, -1, 0}, 2)};
     std::vector<VoxelMap> expected;  // the map after k sessions
     for (size_t k = 0; k <= sessions.size(); ++k) {
         expected.push_back(InMemory({sessions.begin(), sessions.begin() + static_cast<long>(k)}));
@@ -372,8 +375,11 @@ TEST(Store, AFailedCommitLeavesThePreviousCommitAndNoFiles) {
         options.fault_hook = [&](const std::string& at) {
             if (at == step) throw std::runtime_error("injected failure at " + at);
         };
-        EXPECT_TRUE(ThrowsNaming([&] { (void)Write(map, Session(10, {2, 0, 0}), options); },
-                                 "injected failure at " + step));
+        EXPECT_TRUE(ThrowsNaming(
+            [&] {
+                (void)Write(map, Session(10, {2, 0, 0}), options);
+            },
+            "injected failure at " + step));
         const auto after = map.Latest();
         EXPECT_EQ(after.commit, before.commit) << step;
         EXPECT_EQ(after.sessions.size(), 1u) << step;
@@ -441,17 +447,18 @@ TEST(Store, ReadOnlyMapsOpenForReadingOnly) {
     fs::permissions(dir / "catalog.sqlite",
                     fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write,
                     fs::perm_options::remove);
-    EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(dir, MapStore::Access::kWrite); },
-                             "read-only"));
+    EXPECT_TRUE(
+        ThrowsNaming([&] { (void)MapStore::Open(dir, MapStore::Access::kWrite); }, "read-only"));
     const MapStore map = MapStore::Open(dir, MapStore::Access::kRead);
     EXPECT_EQ(map.Latest().sessions.size(), 1u);
     fs::permissions(dir, fs::perms::owner_write, fs::perm_options::add);
     fs::permissions(dir / "catalog.sqlite", fs::perms::owner_write, fs::perm_options::add);
 }
 
-// A fuzz finding (fuzz_catalog, docs/reliability.md). Opening a map whose catalog.sqlite is not a database threw from inside the Database
-// constructor, whose destructor then never closed the SQLite connection: one file descriptor
-// lost per refused catalog, until fuzz_catalog could not open files any more (after 23000).
+// A fuzz finding (fuzz_catalog, docs/reliability.md). Opening a map whose catalog.sqlite is not a
+// database threw from inside the Database constructor, whose destructor then never closed the
+// SQLite connection: one file descriptor lost per refused catalog, until fuzz_catalog could not
+// open files any more (after 23000).
 size_t OpenFileDescriptors() {
     size_t n = 0;
     for (const auto& entry : fs::directory_iterator("/proc/self/fd")) n += entry.exists() ? 1 : 0;
@@ -469,5 +476,131 @@ TEST(MapStoreFuzzFindings, RefusingADamagedCatalogClosesIt) {
     EXPECT_EQ(OpenFileDescriptors(), before);
 }
 
+// A product grid over the room (several tiles): value `value` on the occupied voxels of z = 0.
+openvdb::FloatGrid::Ptr ProductOver(const VoxelMap& map, float value) {
+    auto grid = openvdb::FloatGrid::create(0.0f);
+    grid->setName("slant_deg");
+    grid->setTransform(VoxelMap::MakeTransform(kVoxel));
+    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it > 0.0f && it.getCoord().z() == 0) grid->tree().setValueOn(it.getCoord(), value);
+    }
+    return grid;
+}
+
+size_t ProductVoxels(const MapStore& map, const std::string& name) {
+    size_t n = 0;
+    for (const auto& v : map.Latest().tiles) {
+        for (const auto& g : map.ReadTile(v).products)
+            n += g->getName() == name ? g->activeVoxelCount() : 0;
+    }
+    return n;
+}
+
+TEST(Store, AnalysisProductsReplaceTheirGridsInOneCommit) {
+    const fs::path dir = Temp("products");
+    MapStore map = NewMap(dir);
+    (void)Write(map, Session(1, {0, 0, 0}));
+    const auto before = map.Latest();
+    const VoxelMap fused = map.LoadMap(before);
+    const auto first = ProductOver(fused, 88.0f);
+    ASSERT_GT(first->activeVoxelCount(), 100u);
+    strata::store::WallRecord wall;
+    wall.wall_id = 1;
+    wall.slant_deg = 88.0;
+    wall.inliers = 42;
+    const int64_t c1 = map.CommitProducts("walls", {first}, {wall, wall});
+    EXPECT_GT(c1, before.commit);
+    EXPECT_EQ(ProductVoxels(map, "slant_deg"), first->activeVoxelCount());
+    ASSERT_EQ(map.Walls().size(), 2u);
+    EXPECT_EQ(map.Walls()[0].commit, c1);
+    EXPECT_EQ(map.Walls()[0].inliers, 42u);
+    // The fused map and the sessions are untouched; the map as of the session has no products.
+    ExpectSameMap(map.LoadMap(map.Latest()), fused);
+    EXPECT_EQ(map.Latest().sessions.size(), 1u);
+    for (const auto& v : map.AsOf(1).tiles) EXPECT_TRUE(map.ReadTile(v).products.empty());
+    // A second run replaces the grid and the rows, it does not add to them.
+    auto second = openvdb::FloatGrid::create(0.0f);
+    second->setName("slant_deg");
+    second->setTransform(VoxelMap::MakeTransform(kVoxel));
+    second->tree().setValueOn(openvdb::Coord(1, 1, 0), 90.0f);
+    (void)map.CommitProducts("walls", {second}, {wall});
+    EXPECT_EQ(ProductVoxels(map, "slant_deg"), 1u);
+    EXPECT_EQ(map.Walls().size(), 1u);
+    EXPECT_TRUE(map.Check().ok());
+    // A session integrated later keeps the products as they were.
+    (void)Write(map, Session(5, {1, 0, 0}));
+    EXPECT_EQ(ProductVoxels(map, "slant_deg"), 1u);
+}
+
+TEST(Store, AFailedProductCommitLeavesTheMapAsItWas) {
+    const fs::path dir = Temp("products_fail");
+    MapStore map = NewMap(dir);
+    (void)Write(map, Session(1, {0, 0, 0}));
+    const auto before = map.Latest();
+    const size_t files = map.TileFileCount();
+    auto misaligned = ProductOver(map.LoadMap(before), 1.0f);
+    misaligned->setTransform(VoxelMap::MakeTransform(2 * kVoxel));
+    EXPECT_TRUE(
+        ThrowsNaming([&] { (void)map.CommitProducts("walls", {misaligned}); }, "not aligned"));
+    EXPECT_THROW((void)map.CommitProducts("paint", {}), std::invalid_argument);
+    // A tile that cannot be written (its folder is read-only) fails the whole commit.
+    const fs::path tile_dir = (dir / before.tiles.back().file).parent_path();
+    fs::permissions(tile_dir, fs::perms::owner_write, fs::perm_options::remove);
+    const bool enforced = ::access(tile_dir.c_str(), W_OK) != 0;  // root ignores permissions
+    if (enforced) {
+        EXPECT_THROW((void)map.CommitProducts("walls", {ProductOver(map.LoadMap(before), 1.0f)}),
+                     std::runtime_error);
+    }
+    fs::permissions(tile_dir, fs::perms::owner_write, fs::perm_options::add);
+    EXPECT_EQ(map.Latest().commit, before.commit);
+    EXPECT_EQ(map.TileFileCount(), files);
+    EXPECT_TRUE(map.Walls().empty());
+    const auto report = map.Check();
+    EXPECT_TRUE(report.ok());
+    EXPECT_TRUE(report.unreferenced.empty());
+    MapStore reader = MapStore::Open(dir, MapStore::Access::kRead);
+    EXPECT_THROW((void)reader.CommitProducts("walls", {}), std::logic_error);
+}
+
+TEST(Store, MigratesAFormat2CatalogToFormat3) {
+    const fs::path dir = Temp("migrate");
+    {
+        MapStore map = NewMap(dir);
+        (void)Write(map, Session(1, {0, 0, 0}));
+    }
+    // Put the catalog back to format 2: the commits CHECK and the walls table of that version.
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir / "catalog.sqlite").c_str(), &db), SQLITE_OK);
+    const char* downgrade = R"sql(
+CREATE TABLE commits_v2 (id INTEGER PRIMARY KEY AUTOINCREMENT, time_utc TEXT NOT NULL,
+  session_id INTEGER,
+  kind TEXT NOT NULL CHECK (kind IN ('create', 'integrate', 'remove_session')));
+INSERT INTO commits_v2 SELECT id, time_utc, session_id, kind FROM commits;
+DROP TABLE commits;
+ALTER TABLE commits_v2 RENAME TO commits;
+DROP TABLE walls;
+CREATE TABLE walls (id INTEGER PRIMARY KEY AUTOINCREMENT,
+  commit_id INTEGER NOT NULL REFERENCES commits(id), center_x REAL, center_y REAL, center_z REAL,
+  normal_x REAL, normal_y REAL, normal_z REAL, slant_deg REAL, length_m REAL, height_m REAL,
+  points INTEGER);
+PRAGMA user_version = 2;
+UPDATE settings SET value = '2' WHERE key = 'format_version';
+)sql";
+    ASSERT_EQ(sqlite3_exec(db, downgrade, nullptr, nullptr, nullptr), SQLITE_OK)
+        << sqlite3_errmsg(db);
+    sqlite3_close(db);
+    {
+        const MapStore old = MapStore::Open(dir, MapStore::Access::kRead);
+        EXPECT_EQ(old.settings().format_version, 2);
+        EXPECT_TRUE(old.Walls().empty());  // readers do not migrate
+    }
+    MapStore map = MapStore::Open(dir, MapStore::Access::kWrite);
+    EXPECT_EQ(map.settings().format_version, MapStore::kFormatVersion);
+    EXPECT_EQ(map.Latest().sessions.size(), 1u);
+    const int64_t commit = map.CommitProducts("walls", {}, {strata::store::WallRecord{}});
+    EXPECT_EQ(map.Walls().size(), 1u);
+    EXPECT_GT(commit, map.Latest().sessions[0].commit);
+    EXPECT_EQ(Write(map, Session(5, {1, 0, 0})).id, 2);
+}
 
 }  // namespace

@@ -132,6 +132,22 @@ struct ChangeSetRecord {
     std::string report;  ///< the JSON report
 };
 
+/// @brief One wall as the catalog keeps it (`strata walls`; docs/walls.md). Map frame, metres.
+struct WallRecord {
+    int64_t commit = 0;  ///< the commit that stored it (set by the store)
+    int wall_id = 0;     ///< id in that commit's `wall_id` grid
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+    double slant_deg = 90.0;
+    double uncertainty_deg = 0.0;
+    double lean_azimuth_deg = 0.0;
+    double area_m2 = 0.0;
+    double rms_m = 0.0;
+    double length_m = 0.0;
+    double height_m = 0.0;
+    size_t inliers = 0;
+};
+
 struct GcReport {
     std::vector<std::string> removed;
     uint64_t bytes = 0;
@@ -152,7 +168,7 @@ public:
     enum class Access { kRead, kWrite };
 
     /// The newest catalog format this build reads and writes.
-    static constexpr int kFormatVersion = 2;
+    static constexpr int kFormatVersion = 3;
 
     /// True when `dir` holds a catalog.
     [[nodiscard]] static bool IsMap(const std::filesystem::path& dir);
@@ -201,6 +217,16 @@ public:
     /// voxels are rebuilt from the remaining sessions' layers. One commit; returns its id.
     /// Writer only.
     int64_t RemoveSession(int64_t session_id);
+
+    /// Stores analysis products in one commit of kind `kind` ("walls" or "vehicles"): grids
+    /// named as any of `products` leave every tile of the newest commit, the grids themselves
+    /// (map frame, any type) are split by tile and added, and `walls` become the catalog's wall
+    /// rows of this commit. Tile files are written first and removed again when anything fails,
+    /// so the map stays as it was. Returns the commit id. Writer only.
+    int64_t CommitProducts(const std::string& kind, const openvdb::GridPtrVec& products,
+                           const std::vector<WallRecord>& walls = {});
+    /// The walls of the newest commit that stored walls (empty when none did).
+    [[nodiscard]] std::vector<WallRecord> Walls() const;
 
     /// Keeps a change set in the catalog; returns its id. Writer only.
     int64_t SaveChangeSet(const ChangeSetRecord& record);

@@ -1,0 +1,142 @@
+// Analysis products in the store: grids split by tile and written as new tile versions, with the
+// catalog rows of the analysis, in one commit.
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+#include "store/Catalog.hpp"
+#include "store/MapStoreImpl.hpp"
+#include "store/TileFile.hpp"
+#include "strata/store/MapStore.hpp"
+
+namespace strata::store {
+
+namespace fs = std::filesystem;
+using detail::Transaction;
+
+namespace {
+
+void InsertWalls(const detail::Database& db, int64_t commit, const std::vector<WallRecord>& walls) {
+    for (const WallRecord& w : walls) {
+        detail::Statement q(db,
+                            "INSERT INTO walls(commit_id, wall_id, center_x, center_y, center_z, "
+                            "normal_x, normal_y, normal_z, slant_deg, uncertainty_deg, "
+                            "lean_azimuth_deg, area_m2, rms_m, length_m, height_m, inliers) "
+                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        q.Bind(1, commit).Bind(2, static_cast<int64_t>(w.wall_id));
+        for (int k = 0; k < 3; ++k) q.Bind(3 + k, w.center[k]);
+        for (int k = 0; k < 3; ++k) q.Bind(6 + k, w.normal[k]);
+        q.Bind(9, w.slant_deg)
+            .Bind(10, w.uncertainty_deg)
+            .Bind(11, w.lean_azimuth_deg)
+            .Bind(12, w.area_m2)
+            .Bind(13, w.rms_m)
+            .Bind(14, w.length_m)
+            .Bind(15, w.height_m)
+            .Bind(16, static_cast<int64_t>(w.inliers))
+            .Run();
+    }
+}
+
+}  // namespace
+
+int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtrVec& products,
+                                 const std::vector<WallRecord>& walls) {
+    impl_->RequireWriter("storing analysis products");
+    if (kind != "walls" && kind != "vehicles") {
+        throw std::invalid_argument("unknown kind of analysis commit '" + kind + "'");
+    }
+    const Impl& impl = *impl_;
+    std::set<std::string> names;
+    for (const auto& g : products) {
+        if (!g || g->getName().empty()) throw std::invalid_argument("a product grid needs a name");
+        if (g->transform() != *core::VoxelMap::MakeTransform(impl.settings.voxel_size_m)) {
+            throw std::invalid_argument("product grid '" + g->getName() +
+                                        "' is not aligned with the map's voxels");
+        }
+        names.insert(g->getName());
+    }
+    const Snapshot latest = Latest();
+    const auto last = detail::ReadLastVersions(*impl.db);
+    std::vector<TileVersion> written;
+    std::set<fs::path> dirs;
+    try {
+        for (const TileVersion& current : latest.tiles) {
+            Tile tile = ReadTile(current);
+            const size_t before = tile.products.size();
+            tile.products.erase(std::remove_if(tile.products.begin(), tile.products.end(),
+                                               [&](const openvdb::GridBase::Ptr& g) {
+                                                   return names.count(g->getName()) > 0;
+                                               }),
+                                tile.products.end());
+            bool changed = tile.products.size() != before;
+            const openvdb::CoordBBox bounds = impl.settings.TileBounds(tile.key);
+            for (const auto& g : products) {
+                openvdb::GridBase::Ptr piece = g->deepCopyGrid();
+                piece->clip(bounds);
+                if (piece->empty()) continue;
+                tile.products.push_back(piece);
+                changed = true;
+            }
+            if (!changed) continue;
+            TileVersion v;
+            v.key = tile.key;
+            v.version = last.at(tile.key) + 1;
+            const detail::EncodedTile encoded = detail::EncodeTile(tile);
+            v.file = impl.TileFile(tile.key, v.version);
+            detail::WriteTileFile(impl.dir / v.file, encoded.bytes);
+            written.push_back(v);
+            written.back().bytes = encoded.bytes.size();
+            written.back().checksum = encoded.checksum;
+            dirs.insert(impl.TileDir(tile.key));
+        }
+        for (const fs::path& d : dirs) detail::SyncDirectory(d);
+        Transaction tx(*impl.db, Transaction::Kind::kWrite);
+        const int64_t commit = detail::InsertCommit(*impl.db, kind, 0);
+        for (TileVersion& v : written) {
+            v.commit = commit;
+            detail::InsertTileVersion(*impl.db, v);
+        }
+        InsertWalls(*impl.db, commit, walls);
+        tx.Commit();
+        return commit;
+    } catch (...) {
+        // Nothing references the new files yet: remove them so the map stays as it was.
+        for (const TileVersion& v : written) {
+            std::error_code ignored;
+            fs::remove(impl.dir / v.file, ignored);
+        }
+        throw;
+    }
+}
+
+std::vector<WallRecord> MapStore::Walls() const {
+    const detail::Database& db = *impl_->db;
+    std::vector<WallRecord> out;
+    if (detail::CatalogVersion(db) < 3) return out;  // older read-only map: no walls stored
+    detail::Statement q(db,
+                        "SELECT commit_id, wall_id, center_x, center_y, center_z, normal_x, "
+                        "normal_y, normal_z, slant_deg, uncertainty_deg, lean_azimuth_deg, "
+                        "area_m2, rms_m, length_m, height_m, inliers FROM walls "
+                        "WHERE commit_id = (SELECT MAX(id) FROM commits WHERE kind = 'walls') "
+                        "ORDER BY wall_id");
+    while (q.Step()) {
+        WallRecord w;
+        w.commit = q.Int(0);
+        w.wall_id = static_cast<int>(q.Int(1));
+        for (int k = 0; k < 3; ++k) w.center[k] = q.Real(2 + k);
+        for (int k = 0; k < 3; ++k) w.normal[k] = q.Real(5 + k);
+        w.slant_deg = q.Real(8);
+        w.uncertainty_deg = q.Real(9);
+        w.lean_azimuth_deg = q.Real(10);
+        w.area_m2 = q.Real(11);
+        w.rms_m = q.Real(12);
+        w.length_m = q.Real(13);
+        w.height_m = q.Real(14);
+        w.inliers = static_cast<size_t>(q.Int(15));
+        out.push_back(w);
+    }
+    return out;
+}
+
+}  // namespace strata::store
