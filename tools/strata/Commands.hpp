@@ -14,5 +14,6 @@ void RegisterSimulate(CLI::App& app);
 void RegisterSession(CLI::App& app);
 void RegisterMaintenance(CLI::App& app);
 void RegisterDiff(CLI::App& app);
+void RegisterWalls(CLI::App& app);
 
 }  // namespace strata::tools

@@ -144,9 +144,8 @@ void Run(const DiffArgs& args) {
     query.support_depth_voxels = args.support;
 
     // --save writes the catalog: open as the writer up front, so a busy map fails before work.
-    store::MapStore map = args.save
-                              ? store::MapStore::Open(args.map, store::MapStore::Access::kWrite)
-                              : OpenMap(args.map);
+    store::MapStore map = OpenMap(
+        args.map, args.save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
     change::MapObserver observer(map, query.region);
     const Side a = Resolve(args.from.empty() ? "map" : args.from, map, observer);
     const Side b = scans ? ObserveScans(args, map) : Resolve(args.to, map, observer);

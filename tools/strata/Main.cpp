@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     strata::tools::RegisterSession(app);
     strata::tools::RegisterMaintenance(app);
     strata::tools::RegisterDiff(app);
+    strata::tools::RegisterWalls(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     try {

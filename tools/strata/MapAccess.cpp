@@ -15,12 +15,12 @@ fs::path FindDataDir() {
     return {};
 }
 
-store::MapStore OpenMap(const fs::path& dir) {
+store::MapStore OpenMap(const fs::path& dir, store::MapStore::Access access) {
     if (!fs::exists(dir)) {
         throw std::runtime_error(dir.string() + ": no map here (create one with `strata integrate " +
                                  dir.string() + " --kitti SEQ`)");
     }
-    return store::MapStore::Open(dir, store::MapStore::Access::kRead);
+    return store::MapStore::Open(dir, access);
 }
 
 store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of) {

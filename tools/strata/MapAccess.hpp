@@ -12,8 +12,10 @@ namespace strata::tools {
 /// from the executable's source checkout. Empty when none exists.
 [[nodiscard]] std::filesystem::path FindDataDir();
 
-/// Opens MAP for reading, failing with a message that says how to create one.
-[[nodiscard]] store::MapStore OpenMap(const std::filesystem::path& dir);
+/// Opens MAP for reading (or as its writer), failing with a message that says how to create one.
+[[nodiscard]] store::MapStore OpenMap(
+    const std::filesystem::path& dir,
+    store::MapStore::Access access = store::MapStore::Access::kRead);
 
 /// The commit a read command shows: the newest, or the one right after session `as_of` (an id
 /// or a name) when given.

@@ -1,0 +1,155 @@
+// `strata walls` through the program, on the first scans of the simulated street (a facade
+// leaning 4 degrees towards the street at x 22-38 m, y -9 m).
+#include <gtest/gtest.h>
+#include <openvdb/openvdb.h>
+
+#include <nlohmann/json.hpp>
+
+#include "CliTestUtil.hpp"
+#include "strata/io/Image.hpp"
+#include "strata/store/MapStore.hpp"
+
+namespace strata::tools::test {
+namespace {
+
+using nlohmann::json;
+
+// The flat_slanted facade of datasets/scenes/street.json.
+constexpr double kFacadeSlantDeg = 86.0;
+// Twelve scans see only part of it, from one side: looser than the full-street accuracy test.
+constexpr double kSlantTolDeg = 0.5;
+// Walls share few voxels (corners).
+constexpr double kMinDistinctInliers = 0.99;
+
+// One map per test binary (simulating and integrating takes a few seconds).
+const fs::path& StreetMap() {
+    static const fs::path map = [] {
+        const fs::path seq = Temp("walls_seq");
+        const fs::path dir = Temp("walls_map");
+        const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
+        const Result sim = Strata("simulate --scene " + scene + " --out " + seq.string() +
+                                  " --max-scans 12 --no-picture");
+        EXPECT_EQ(sim.code, 0) << sim.out;
+        const Result integrate = Strata("integrate " + dir.string() + " --kitti " + seq.string());
+        EXPECT_EQ(integrate.code, 0) << integrate.out;
+        return dir;
+    }();
+    return map;
+}
+
+// A copy of the street map the test may change.
+fs::path CopyOfStreet(const std::string& name) {
+    const fs::path dir = Temp(name);
+    fs::copy(StreetMap(), dir, fs::copy_options::recursive);
+    fs::remove(dir / "writer.lock");
+    return dir;
+}
+
+const json* FacadeIn(const json& report) {
+    for (const json& w : report.at("walls")) {
+        const auto& c = w.at("centroid");
+        if (c[0] > 22.0 && c[0] < 38.0 && std::abs(c[1].get<double>() + 9.0) < 0.5) return &w;
+    }
+    return nullptr;
+}
+
+TEST(WallsCli, ReportsTheLeaningFacadeWithTheFixedKeysAndLeavesTheMapWithNoSave) {
+    const fs::path map = CopyOfStreet("walls_json");
+    const auto before = MapFiles(map);
+    const Result r = Strata("walls " + map.string() + " --json --no-save");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const json report = json::parse(r.out);
+    ASSERT_FALSE(report.at("walls").empty());
+    for (const json& w : report.at("walls")) {
+        for (const char* key : {"id", "slant_deg", "centroid", "normal", "inliers", "area_m2",
+                                "rms_m", "uncertainty_deg", "lean_azimuth_deg"}) {
+            ASSERT_TRUE(w.contains(key)) << key;
+        }
+        EXPECT_GE(w.at("slant_deg").get<double>(), 0.0);
+        EXPECT_LE(w.at("slant_deg").get<double>(), 90.0);
+    }
+    const json* facade = FacadeIn(report);
+    ASSERT_NE(facade, nullptr) << r.out;
+    EXPECT_NEAR(facade->at("slant_deg").get<double>(), kFacadeSlantDeg, kSlantTolDeg);
+    EXPECT_GT(facade->at("normal")[1].get<double>(), 0.0) << "faces the street (+y)";
+    EXPECT_NEAR(facade->at("lean_azimuth_deg").get<double>(), 90.0, 5.0) << "leans to +y";
+    EXPECT_EQ(MapFiles(map), before);
+}
+
+TEST(WallsCli, WritesReportsPicturesAndGrids) {
+    const fs::path map = CopyOfStreet("walls_files");
+    const fs::path out = Temp("walls_out");
+    fs::create_directories(out);
+    const Result r =
+        Strata("walls " + map.string() + " --no-save --png " + (out / "w.png").string() +
+               " --csv " + (out / "w.csv").string() + " --vdb " + (out / "w.vdb").string() +
+               " --columns-png " + (out / "c.png").string() + " --columns-csv " +
+               (out / "c.csv").string() + " --columns-vdb " + (out / "c.vdb").string());
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_GT(io::ReadPng(out / "w.png").width(), 100);
+    EXPECT_GT(io::ReadPng(out / "c.png").width(), 100);
+    const std::string csv = ReadText(out / "w.csv");
+    EXPECT_EQ(csv.rfind("id,slant_deg,uncertainty_deg", 0), 0u);
+    EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 1);
+    const std::string columns = ReadText(out / "c.csv");
+    EXPECT_GT(std::count(columns.begin(), columns.end(), '\n'), 100);
+    openvdb::initialize();
+    for (const auto& [file, names] : std::vector<std::pair<std::string, std::vector<std::string>>>{
+             {"w.vdb", {"slant_deg", "wall_id"}},
+             {"c.vdb", {"column_points", "column_extent_m"}}}) {
+        openvdb::io::File vdb((out / file).string());
+        vdb.open();
+        for (const auto& name : names) EXPECT_TRUE(vdb.hasGrid(name)) << file << " " << name;
+        vdb.close();
+    }
+}
+
+TEST(WallsCli, StoresTheProductsInTheMap) {
+    const fs::path map = CopyOfStreet("walls_store");
+    const Result r = Strata("walls " + map.string());
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("stored slant_deg and wall_id grids"), std::string::npos) << r.out;
+    const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
+    const auto walls = store.Walls();
+    ASSERT_FALSE(walls.empty());
+    size_t stored = 0;
+    for (const auto& v : store.Latest().tiles) {
+        for (const auto& g : store.ReadTile(v).products) {
+            if (g->getName() == "slant_deg") stored += g->activeVoxelCount();
+        }
+    }
+    size_t inliers = 0;
+    for (const auto& w : walls) inliers += w.inliers;
+    // Every inlier voxel is stored once; a voxel two walls share (a corner) keeps one id.
+    EXPECT_LE(stored, inliers);
+    EXPECT_GE(stored, static_cast<size_t>(kMinDistinctInliers * inliers));
+    EXPECT_TRUE(store.Check().ok());
+    // Running again replaces them; the map as of the session is readable and has none.
+    EXPECT_EQ(Strata("walls " + map.string()).code, 0);
+    EXPECT_EQ(store::MapStore::Open(map, store::MapStore::Access::kRead).Walls().size(),
+              walls.size());
+    EXPECT_EQ(Strata("walls " + map.string() + " --as-of 1 --json").code, 0);
+}
+
+TEST(WallsCli, BadInputFailsNamingTheProblemAndLeavesTheMap) {
+    const fs::path map = CopyOfStreet("walls_bad");
+    const auto before = MapFiles(map);
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"walls " + (map / "nope").string(), "no map here"},
+        {"walls " + map.string() + " --window 0", "window_m"},
+        {"walls " + map.string() + " --divisor 0", "kmeans_divisor"},
+        {"walls " + map.string() + " --eigen-ratio 0.5", "min_eigen_ratio"},
+        {"walls " + map.string() + " --as-of 7", "7"},
+        {"walls " + map.string() + " --png /nonexistent/dir/w.png", "/nonexistent/dir/w.png"},
+    };
+    for (const auto& [args, what] : cases) {
+        const Result r = Strata(args);
+        EXPECT_NE(r.code, 0) << args;
+        EXPECT_NE(r.out.find(what), std::string::npos) << args << ": " << r.out;
+    }
+    EXPECT_EQ(MapFiles(map), before);
+    EXPECT_TRUE(store::MapStore::Open(map, store::MapStore::Access::kRead).Walls().empty());
+}
+
+}  // namespace
+}  // namespace strata::tools::test
