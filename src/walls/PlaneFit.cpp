@@ -153,24 +153,26 @@ double XyEigenRatio(const std::vector<Eigen::Vector3d>& points) {
     return small > 0.0 ? large / small : std::numeric_limits<double>::infinity();
 }
 
-double SlantDeg(const Eigen::Vector3d& normal) {
-    const double norm = normal.norm();
+double SlantDeg(const Eigen::Vector3d& normal, const Eigen::Vector3d& up) {
+    const double norm = normal.norm() * up.norm();
     if (!(norm > 0.0)) return 0.0;
-    return std::acos(std::clamp(std::abs(normal.z()) / norm, 0.0, 1.0)) * kDegPerRad;
+    return std::acos(std::clamp(std::abs(normal.dot(up)) / norm, 0.0, 1.0)) * kDegPerRad;
 }
 
-double LeanAzimuthDeg(const Eigen::Vector3d& normal) {
-    // The top moves along the horizontal part of the normal, towards it when the face looks
-    // down (n_z < 0), away from it when it looks up.
-    const Eigen::Vector2d lean = -normal.z() * normal.head<2>();
-    if (lean.norm() < 1e-12) {
-        // Vertical (or horizontal) plane: no lean; report the facing direction.
-        if (normal.head<2>().norm() < 1e-12) return 0.0;
-        const double a = std::atan2(normal.y(), normal.x()) * kDegPerRad;
+double LeanAzimuthDeg(const Eigen::Vector3d& normal, const Eigen::Vector3d& up) {
+    const auto azimuth = [](const Eigen::Vector3d& v) {
+        const double a = std::atan2(v.y(), v.x()) * kDegPerRad;
         return a < 0.0 ? a + 360.0 : a;
-    }
-    const double a = std::atan2(lean.y(), lean.x()) * kDegPerRad;
-    return a < 0.0 ? a + 360.0 : a;
+    };
+    // The top moves along the horizontal part of the normal, towards it when the face looks
+    // down (n . up < 0), away from it when it looks up.
+    const Eigen::Vector3d u = up.normalized();
+    const double vertical = normal.dot(u);
+    const Eigen::Vector3d horizontal = normal - vertical * u;
+    if (horizontal.norm() < 1e-12) return 0.0;  // a horizontal plane faces nowhere
+    const Eigen::Vector3d lean = -vertical * horizontal;
+    if (lean.norm() < 1e-12) return azimuth(horizontal);  // vertical: the way it faces
+    return azimuth(lean);
 }
 
 double SlantUncertaintyDeg(const PlaneFit& fit) {

@@ -55,6 +55,7 @@ std::string WallsJson(const WallResult& result, const WallConfig& config,
     for (const Wall& w : result.walls) {
         walls.push_back({{"id", w.id},
                          {"slant_deg", Round(w.slant_deg, 1e-4)},
+                         {"slant_to_ground_deg", Round(w.slant_to_ground_deg, 1e-4)},
                          {"centroid", Vec(w.centroid)},
                          {"normal", Vec(w.normal)},
                          {"d", w.d},
@@ -76,6 +77,10 @@ std::string WallsJson(const WallResult& result, const WallConfig& config,
     j["voxel_size"] = result.voxel_size;
     j["origin"] = Vec(origin);
     j["slant_convention"] = kConvention;
+    j["up"] = Vec(result.up);
+    j["ground"] = {{"normal", Vec(result.ground.normal)},
+                   {"tilt_deg", Round(result.ground.tilt_deg, 1e-4)},
+                   {"columns", result.ground.columns}};
     j["stats"] = {{"occupied_columns", s.occupied_columns},
                   {"voting_columns", s.voting_columns},
                   {"candidate_voxels", s.candidate_voxels},
@@ -100,7 +105,8 @@ std::string WallsJson(const WallResult& result, const WallConfig& config,
                    {"min_slant_deg", config.min_slant_deg},
                    {"min_part_height_m", config.min_part_height_m},
                    {"min_part_length_m", config.min_part_length_m},
-                   {"refine", config.refine}};
+                   {"refine", config.refine},
+                   {"level_to_ground", config.level_to_ground}};
     return j.dump(2) + "\n";
 }
 

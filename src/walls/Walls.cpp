@@ -89,25 +89,17 @@ double HorizontalExtent(const std::vector<Eigen::Vector3d>& points, const Eigen:
     return hi - lo;
 }
 
-// Adds to `voxels` their 26-neighbours that hold endpoints (hits) but are not in the set.
-void AddHitNeighbours(const core::VoxelMap& map, std::vector<openvdb::Coord>& voxels) {
-    openvdb::BoolGrid::Ptr in = openvdb::BoolGrid::create(false);
-    auto member = in->getAccessor();
-    for (const auto& c : voxels) member.setValueOn(c, true);
-    auto hits = map.hits->getConstAccessor();
-    const size_t n = voxels.size();
-    for (size_t i = 0; i < n; ++i) {
-        for (int dz = -1; dz <= 1; ++dz) {
-            for (int dy = -1; dy <= 1; ++dy) {
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const openvdb::Coord q = voxels[i].offsetBy(dx, dy, dz);
-                    if (member.isValueOn(q) || hits.getValue(q) <= 0) continue;
-                    member.setValueOn(q, true);
-                    voxels.push_back(q);
-                }
-            }
-        }
-    }
+// One-sigma of the mean of `values` from their median absolute deviation (0 for fewer than 3).
+double SpreadOfMean(std::vector<double> values) {
+    if (values.size() < 3) return 0.0;
+    const auto median = [](std::vector<double>& v) {
+        std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    };
+    const double m = median(values);
+    for (double& v : values) v = std::abs(v - m);
+    constexpr double kMadToSigma = 1.4826;
+    return kMadToSigma * median(values) / std::sqrt(static_cast<double>(values.size()));
 }
 
 core::SemanticClass DominantClass(const core::VoxelMap& map,
@@ -202,6 +194,34 @@ std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
     return candidates;
 }
 
+GroundPlane EstimateGround(const core::VoxelMap& map, const columns::ColumnGrid& columns,
+                           uint64_t seed) {
+    constexpr size_t kMaxColumns = 50000;  // a sample is plenty for one plane
+    std::vector<Eigen::Vector3d> lowest;
+    for (int j = 0; j < columns.height(); ++j) {
+        for (int i = 0; i < columns.width(); ++i) {
+            const openvdb::Coord column(columns.min_i() + i, columns.min_j() + j, 0);
+            const columns::ColumnStat& c = columns.At(column.x(), column.y());
+            if (c.voxels > 0) lowest.push_back(map.PointMean(column.offsetBy(0, 0, c.k_min)));
+        }
+    }
+    GroundPlane ground;
+    if (lowest.size() < 3) return ground;
+    if (lowest.size() > kMaxColumns) {
+        std::vector<Eigen::Vector3d> sample;
+        const double step = static_cast<double>(lowest.size()) / kMaxColumns;
+        for (size_t k = 0; k < kMaxColumns; ++k) {
+            sample.push_back(lowest[static_cast<size_t>(static_cast<double>(k) * step)]);
+        }
+        lowest.swap(sample);
+    }
+    const RansacResult r = RansacPlane(lowest, map.voxel_size, 200, seed);
+    ground.normal = r.plane.normal.z() < 0.0 ? Eigen::Vector3d(-r.plane.normal) : r.plane.normal;
+    ground.tilt_deg = SlantDeg(ground.normal);  // 0 for a level ground
+    ground.columns = r.inliers;
+    return ground;
+}
+
 WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     config.Validate();
     if (!map.occupancy) throw std::invalid_argument("walls: the map has no occupancy grid");
@@ -215,6 +235,12 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     const int radius = std::max(0, static_cast<int>(std::lround(config.window_m / s / 2.0 - 0.5)));
     const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(map);
     result.stats.occupied_columns = cols.OccupiedColumns();
+    // Where a voxel's surface is: the mean of its endpoints (or its centre, for comparison).
+    const auto position = [&](const openvdb::Coord& c) {
+        return config.use_point_means ? map.PointMean(c) : map.VoxelCenter(c);
+    };
+    result.ground = EstimateGround(map, cols, config.seed);
+    if (config.level_to_ground) result.up = result.ground.normal;
     const columns::ColumnGrid window = cols.Window(radius);
     const std::vector<openvdb::Coord> candidates =
         VoteCandidates(map, window, radius, config, &result.stats.voting_columns);
@@ -244,7 +270,7 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     for (int c = 0; c < clusters; ++c) {
         const auto& voxels = members[c];
         std::vector<Eigen::Vector3d> points(voxels.size());
-        for (size_t n = 0; n < voxels.size(); ++n) points[n] = map.PointMean(voxels[n]);
+        for (size_t n = 0; n < voxels.size(); ++n) points[n] = position(voxels[n]);
         const int k = PartsFor(voxels.size(), config.kmeans_divisor);
         const std::vector<int> part_of = KMeans(points, k, config.seed + c);
         std::vector<PartVoxels> local(static_cast<size_t>(k), PartVoxels{c, {}});
@@ -265,7 +291,7 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
         part.voxels = voxels.size();
         part.dominant_class = DominantClass(map, voxels);
         std::vector<Eigen::Vector3d> points(voxels.size());
-        for (size_t n = 0; n < voxels.size(); ++n) points[n] = map.PointMean(voxels[n]);
+        for (size_t n = 0; n < voxels.size(); ++n) points[n] = position(voxels[n]);
         if (voxels.size() < config.min_part_voxels) {
             part.verdict = PartVerdict::kTooSmall;
             result.parts.push_back(part);
@@ -284,7 +310,7 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
         }
         part.inliers = inliers.size();
         part.eigen_ratio = XyEigenRatio(inliers);
-        part.slant_deg = SlantDeg(ransac.plane.normal);
+        part.slant_deg = SlantDeg(ransac.plane.normal, result.up);
         part.height_m = inliers.empty() ? 0.0 : hi.z() - lo.z() + s;
         part.length_m = HorizontalExtent(inliers, ransac.plane.normal) + s;
         for (const auto& q : inliers) part.centroid += q;
@@ -345,16 +371,11 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
         }
         Plane plane =
             RansacPlane(points, threshold, config.ransac_iterations, config.seed + group[0]).plane;
-        // A noisy point lands in the voxel in front of the surface now and then, and that voxel,
-        // crossed by many rays, usually ends up free: keeping only occupied voxels would drop
-        // those points and pull each mean backwards by an amount that changes with the height
-        // of the surface inside its voxel, i.e. tilt the plane. So the fit also takes the
-        // endpoint voxels next to the group that are not occupied, each weighed by its count.
-        AddHitNeighbours(map, voxels);
+        // Each voxel mean stands for its endpoints: weigh it by their number.
         std::vector<Eigen::Vector3d> near;
         std::vector<double> weights;
         for (const auto& c : voxels) {
-            const Eigen::Vector3d p = map.PointMean(c);
+            const Eigen::Vector3d p = position(c);
             if (std::abs(plane.Distance(p)) > threshold) continue;
             near.push_back(p);
             weights.push_back(std::max(1, hits.getValue(c)));
@@ -365,7 +386,7 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
         Wall wall;
         std::vector<Eigen::Vector3d> final_points;
         for (const auto& c : voxels) {
-            const Eigen::Vector3d p = map.PointMean(c);
+            const Eigen::Vector3d p = position(c);
             if (std::abs(plane.Distance(p)) <= threshold) {
                 final_points.push_back(p);
                 wall.voxels.push_back(c);
@@ -382,9 +403,14 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
         wall.centroid = fit.centroid;
         wall.inliers = final_points.size();
         wall.rms_m = fit.rms;
-        wall.slant_deg = SlantDeg(wall.normal);
-        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal);
-        wall.uncertainty_deg = SlantUncertaintyDeg(fit);
+        wall.slant_deg = SlantDeg(wall.normal, result.up);
+        wall.slant_to_ground_deg = SlantDeg(wall.normal, result.ground.normal);
+        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal, result.up);
+        // The fit's own one-sigma treats voxels as independent and misses what windows and
+        // recesses do; the spread of the parts' own slants catches that (robustly: MAD).
+        std::vector<double> part_slants;
+        for (size_t a : group) part_slants.push_back(SlantDeg(pieces[a].plane.normal, result.up));
+        wall.uncertainty_deg = std::max(SlantUncertaintyDeg(fit), SpreadOfMean(part_slants));
         wall.eigen_ratio = XyEigenRatio(final_points);
         wall.parts = static_cast<int>(group.size());
         // A plane crosses about (|nx| + |ny| + |nz|) voxels per voxel face of its area.

@@ -196,6 +196,44 @@ TEST(FindWalls, MeasuresTheSlantOfAHandMadeWallAndLeavesTheBush) {
     }
 }
 
+TEST(FindWalls, EstimatesTheGroundTiltAndCanMeasureAgainstIt) {
+    constexpr double kTiltTolDeg = 0.05;
+    // The hand-made street, seen in a frame rolled by 1.5 deg about x (an unlevelled odometry
+    // frame): ground and wall tilt together.
+    const core::VoxelMap level = HandMadeStreet(0.2);
+    core::VoxelMap rolled = core::VoxelMap::Create(0.2);
+    const Eigen::Matrix3d roll = Eigen::AngleAxisd(1.5 * kRad, Eigen::Vector3d::UnitX()).matrix();
+    auto occ = rolled.occupancy->getAccessor();
+    auto hits = rolled.hits->getAccessor();
+    auto mean = rolled.point_mean->getAccessor();
+    for (auto it = level.occupancy->cbeginValueOn(); it; ++it) {
+        const Eigen::Vector3d p = roll * level.PointMean(it.getCoord());
+        const Coord c = rolled.WorldToVoxel(p);
+        if (*it <= 0.0f) {
+            if (!occ.isValueOn(c)) occ.setValueOn(c, *it);
+            continue;
+        }
+        const Eigen::Vector3d offset = p - rolled.VoxelCenter(c);
+        occ.setValueOn(c, 1.0f);
+        hits.setValueOn(c, 1);
+        mean.setValueOn(c, openvdb::Vec3s(offset.x(), offset.y(), offset.z()));
+    }
+    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(rolled);
+    EXPECT_NEAR(EstimateGround(rolled, cols).tilt_deg, 1.5, kTiltTolDeg);
+    EXPECT_NEAR(EstimateGround(level, columns::ColumnGrid::FromMap(level)).tilt_deg, 0.0,
+                kTiltTolDeg);
+    // The wall leans 2 deg towards -y; rolling by +1.5 deg about x turns it further, to 3.5.
+    const WallResult in_map = FindWalls(rolled);
+    ASSERT_EQ(in_map.walls.size(), 1u);
+    EXPECT_NEAR(in_map.walls[0].slant_deg, 86.5, 0.1);
+    EXPECT_NEAR(in_map.walls[0].slant_to_ground_deg, 88.0, 0.1);
+    WallConfig levelled;
+    levelled.level_to_ground = true;
+    const WallResult against_ground = FindWalls(rolled, levelled);
+    ASSERT_EQ(against_ground.walls.size(), 1u);
+    EXPECT_NEAR(against_ground.walls[0].slant_deg, 88.0, 0.1);
+}
+
 TEST(FindWalls, RejectsABadConfig) {
     const core::VoxelMap map = core::VoxelMap::Create(0.2);
     WallConfig c;

@@ -66,6 +66,15 @@ void PrintSummary(const walls::WallResult& result, const store::MapStore& map) {
               << s.occupied_columns << " columns voted), " << s.clusters << " clusters, "
               << result.parts.size() << " parts; " << std::fixed << std::setprecision(2)
               << s.seconds_columns + s.seconds_clustering + s.seconds_fitting << " s\n";
+    std::cout << "ground plane tilts " << result.ground.tilt_deg << " deg from the map's z axis ("
+              << result.ground.columns << " columns)";
+    if (result.up != Eigen::Vector3d::UnitZ()) {
+        std::cout << "; slants are measured against the ground's normal (--level-to-ground)";
+    } else if (result.ground.tilt_deg >= 1.0) {
+        std::cout << ": if the site is flat, the map's frame is not level and every slant is off "
+                     "by up to that much (--level-to-ground measures against the ground)";
+    }
+    std::cout << "\n";
     std::cout << "   id   slant deg  +-1 sigma  lean az  length m  height m  inliers  rms m   "
                  "centroid (map frame)\n";
     for (const walls::Wall& w : result.walls) {
@@ -143,6 +152,8 @@ void RegisterWalls(CLI::App& app) {
     cmd->add_option("--columns-vdb", args->columns_vdb,
                     "Write the column statistics as 2D grids to a .vdb file");
     cmd->add_flag("--no-save", args->no_save, "Do not store the products in the map");
+    cmd->add_flag("--level-to-ground", c.level_to_ground,
+                  "Measure slants against the ground plane's normal, not the map's z axis");
     cmd->add_option("--window", c.window_m, "Side of the sliding column window (m)")
         ->capture_default_str();
     cmd->add_option("--min-height", c.min_wall_height_m,

@@ -40,7 +40,7 @@ struct WallConfig {
     size_t min_part_voxels = 30;        ///< smaller parts are dropped as clutter
     double min_inlier_fraction = 0.45;  ///< a part's voxels on its plane
     double min_eigen_ratio = 1.7;       ///< x/y eigenvalue ratio of the inliers (the study's 1.7)
-    double min_slant_deg = 60.0;        ///< flatter planes (ground, roofs) are not walls
+    double min_slant_deg = 75.0;        ///< flatter planes (ground, roofs, canopies) are not walls
     double min_part_height_m = 1.5;     ///< vertical extent of a part's inliers
     double min_part_length_m = 1.0;     ///< horizontal extent along the plane (tree trunks fail)
 
@@ -53,6 +53,13 @@ struct WallConfig {
     bool refine = true;              ///< Ceres refinement with a Cauchy loss
     double min_wall_length_m = 1.0;  ///< horizontal extent of a wall's inliers
     uint64_t seed = 1;               ///< RANSAC and K-means seeds (results are deterministic)
+    /// Measure slants against the normal of the ground plane instead of the map's z axis: for
+    /// maps whose frame is not level (odometry that starts in a tilted sensor frame). Sloped
+    /// streets then bias every slant by their slope, so the default is the map's z axis.
+    bool level_to_ground = false;
+    /// Fit planes to the mean endpoint of each voxel (`point_mean`); false fits voxel centres
+    /// (for comparison: docs/walls.md shows what each choice costs).
+    bool use_point_means = true;
 
     /// @brief Throws std::invalid_argument naming the first bad field.
     void Validate() const;
@@ -60,15 +67,18 @@ struct WallConfig {
 
 /// @brief One wall: a plane fitted to the voxels (their centres) of one or more parts.
 struct Wall {
-    int id = 0;                                          ///< 1, 2, ... by decreasing inlier count
-    double slant_deg = 90.0;                             ///< SlantDeg(normal): 90 = vertical
+    int id = 0;                         ///< 1, 2, ... by decreasing inlier count
+    double slant_deg = 90.0;            ///< SlantDeg(normal, WallResult::up): 90 = vertical
+    double slant_to_ground_deg = 90.0;  ///< SlantDeg(normal, WallResult::ground.normal)
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the inliers, map frame
     Eigen::Vector3d normal = Eigen::Vector3d::UnitX();   ///< unit, towards the observed side
     double d = 0.0;                                      ///< plane: normal . x + d = 0
-    size_t inliers = 0;                  ///< voxels within the RANSAC threshold of the plane
-    double area_m2 = 0.0;                ///< surface the inlier voxels cover
-    double rms_m = 0.0;                  ///< of the inliers' distances to the plane
-    double uncertainty_deg = 0.0;        ///< one-sigma slant uncertainty of the fit
+    size_t inliers = 0;    ///< voxels within the RANSAC threshold of the plane
+    double area_m2 = 0.0;  ///< surface the inlier voxels cover
+    double rms_m = 0.0;    ///< of the inliers' distances to the plane
+    /// One-sigma slant uncertainty: the larger of the fit's (voxels taken as independent) and
+    /// the spread (MAD) of its parts' slants over the square root of their number.
+    double uncertainty_deg = 0.0;
     double lean_azimuth_deg = 0.0;       ///< LeanAzimuthDeg(normal)
     double length_m = 0.0;               ///< horizontal extent of the inliers along the wall
     double height_m = 0.0;               ///< vertical extent of the inliers
@@ -114,8 +124,22 @@ struct WallStats {
     double seconds_columns = 0.0, seconds_clustering = 0.0, seconds_fitting = 0.0;
 };
 
+/// @brief The ground plane of a map: RANSAC over the lowest occupied voxel of every column.
+struct GroundPlane {
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, upwards
+    double tilt_deg = 0.0;                              ///< angle between normal and map z
+    size_t columns = 0;                                 ///< columns on the plane
+};
+
+/// @brief Fits the ground plane (threshold: one voxel). A tilt of a degree or more on a flat
+/// site says the map's frame is not level: its slants are then off by as much.
+[[nodiscard]] GroundPlane EstimateGround(const core::VoxelMap& map,
+                                         const columns::ColumnGrid& columns, uint64_t seed = 1);
+
 struct WallResult {
     std::vector<Wall> walls;
+    GroundPlane ground;
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< what slants were measured against
     std::vector<WallPart> parts;
     WallStats stats;
     double voxel_size = 0.0;
