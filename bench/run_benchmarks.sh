@@ -17,8 +17,8 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
   echo
   echo "Same float points, same process, max range 50 m. OctoMap: \`OcTree::insertPointCloud\`"
   echo "(compiled without OpenMP, i.e. one thread). strata: \`Integrator::Integrate\` with TBB limited"
-  echo "to 1 and 2 threads. Memory: \`OcTree::memoryUsage()\` vs the sum of \`memUsage()\` of our four"
-  echo "grids (occupancy, label, label_weight, hits). Jaccard: occupied and free voxel sets, OctoMap's"
+  echo "to 1 and 2 threads. Memory: \`OcTree::memoryUsage()\` vs the sum of \`memUsage()\` of our five"
+  echo "grids (occupancy, label, label_weight, hits, point_mean). Jaccard: occupied and free voxel sets, OctoMap's"
   echo "pruned nodes expanded to voxels. Targets (issue 2) and where the time goes:"
   echo "[integration.md, Speed](integration.md#speed)."
   echo
@@ -51,6 +51,16 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
     echo "operations and grouping). Target: well under a second. Semantics: [change.md](change.md)."
     echo
     "$build/bench/bench_change" "$root/../shared/data"
+  fi
+  if [[ -x "$build/bench/bench_walls" ]]; then
+    echo
+    echo "## Walls (\`bench/bench_walls\`)"
+    echo
+    echo "\`walls::FindWalls\` with default settings on maps integrated in memory (outside the"
+    echo "timing), TBB limited to one thread. Target: a BALM-sized map in a few seconds on one"
+    echo "core. Pipeline and accuracy: [walls.md](walls.md)."
+    echo
+    "$build/bench/bench_walls" "$root/../shared/data"
   fi
   if [[ -x "$build/bench/bench_sim" ]]; then
     echo

@@ -102,35 +102,74 @@ std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint6
         }
         centres.push_back(points[chosen]);
     }
+    // Lloyd's iterations with Hamerly's bounds (2010): the same assignments as plain Lloyd, but a
+    // point is only compared with every centre when its distance bounds cannot rule a change
+    // out. upper[i] bounds the distance to its centre from above, lower[i] the distance to any
+    // other centre from below.
     const int kk = static_cast<int>(centres.size());
+    std::vector<double> upper(n), lower(n), half_gap(kk), moved(kk);
+    const auto nearest_two = [&](size_t i) {
+        double d1 = std::numeric_limits<double>::max(), d2nd = d1;
+        int best = 0;
+        for (int c = 0; c < kk; ++c) {
+            const double d = (points[i] - centres[c]).norm();
+            if (d < d1) {
+                d2nd = d1;
+                d1 = d;
+                best = c;
+            } else if (d < d2nd) {
+                d2nd = d;
+            }
+        }
+        assignment[i] = best;
+        upper[i] = d1;
+        lower[i] = d2nd;
+    };
+    for (size_t i = 0; i < n; ++i) nearest_two(i);
     std::vector<Eigen::Vector3d> sums(kk);
     std::vector<size_t> counts(kk);
     for (int iteration = 0; iteration < max_iterations; ++iteration) {
-        bool changed = iteration == 0;
-        for (size_t i = 0; i < n; ++i) {
-            int best = 0;
-            double best_d = std::numeric_limits<double>::max();
-            for (int c = 0; c < kk; ++c) {
-                const double d = (points[i] - centres[c]).squaredNorm();
-                if (d < best_d) {
-                    best_d = d;
-                    best = c;
-                }
-            }
-            if (assignment[i] != best) {
-                assignment[i] = best;
-                changed = true;
-            }
-        }
-        if (!changed) break;
+        // Move each centre to the mean of its points.
         std::fill(sums.begin(), sums.end(), Eigen::Vector3d::Zero());
         std::fill(counts.begin(), counts.end(), 0);
         for (size_t i = 0; i < n; ++i) {
             sums[assignment[i]] += points[i];
             ++counts[assignment[i]];
         }
+        double most = 0.0, second = 0.0;
+        int most_moved = -1;
         for (int c = 0; c < kk; ++c) {
-            if (counts[c] > 0) centres[c] = sums[c] / static_cast<double>(counts[c]);
+            const Eigen::Vector3d next =
+                counts[c] > 0 ? Eigen::Vector3d(sums[c] / static_cast<double>(counts[c]))
+                              : centres[c];
+            moved[c] = (next - centres[c]).norm();
+            centres[c] = next;
+            if (moved[c] > most) {
+                second = most;
+                most = moved[c];
+                most_moved = c;
+            } else if (moved[c] > second) {
+                second = moved[c];
+            }
+        }
+        if (most == 0.0) break;  // converged: no centre moved, so no point changes
+        for (size_t i = 0; i < n; ++i) {
+            upper[i] += moved[assignment[i]];
+            lower[i] -= assignment[i] == most_moved ? second : most;
+        }
+        for (int c = 0; c < kk; ++c) {
+            double gap = std::numeric_limits<double>::max();
+            for (int o = 0; o < kk; ++o) {
+                if (o != c) gap = std::min(gap, (centres[c] - centres[o]).norm());
+            }
+            half_gap[c] = 0.5 * gap;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            const double bound = std::max(half_gap[assignment[i]], lower[i]);
+            if (upper[i] <= bound) continue;
+            upper[i] = (points[i] - centres[assignment[i]]).norm();
+            if (upper[i] <= bound) continue;
+            nearest_two(i);
         }
     }
     return assignment;

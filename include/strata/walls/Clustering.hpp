@@ -24,7 +24,7 @@ inline constexpr int kNoise = -1;
 /// [1, points.size()].
 /// @return one cluster index in [0, k) per point; empty for no points.
 [[nodiscard]] std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k,
-                                      uint64_t seed = 1, int max_iterations = 50);
+                                      uint64_t seed = 1, int max_iterations = 15);
 
 /// @brief The study's rule for the number of K-means parts of a cluster: floor(n / divisor),
 /// at least 1.
