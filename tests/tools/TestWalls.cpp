@@ -2,6 +2,7 @@
 // leaning 4 degrees towards the street at x 22-38 m, y -9 m).
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -21,11 +22,27 @@ constexpr double kSlantTolDeg = 0.5;
 // Walls share few voxels (corners).
 constexpr double kMinDistinctInliers = 0.99;
 
-// One map per test binary (simulating and integrating takes a few seconds).
+// Scratch names are per process: CTest runs each test of this binary in its own process, in
+// parallel.
+// Each is removed when the process exits (a simulated street map is ~10 MB).
+fs::path Scratch(const std::string& name) {
+    struct Registry {
+        std::vector<fs::path> paths;
+        ~Registry() {
+            std::error_code ignored;
+            for (const auto& p : paths) fs::remove_all(p, ignored);
+        }
+    };
+    static Registry registry;
+    registry.paths.push_back(Temp(name + "_" + std::to_string(::getpid())));
+    return registry.paths.back();
+}
+
+// One map per test process (simulating and integrating takes a few seconds).
 const fs::path& StreetMap() {
     static const fs::path map = [] {
-        const fs::path seq = Temp("walls_seq");
-        const fs::path dir = Temp("walls_map");
+        const fs::path seq = Scratch("walls_seq");
+        const fs::path dir = Scratch("walls_map");
         const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
         const Result sim = Strata("simulate --scene " + scene + " --out " + seq.string() +
                                   " --max-scans 12 --no-picture");
@@ -39,7 +56,7 @@ const fs::path& StreetMap() {
 
 // A copy of the street map the test may change.
 fs::path CopyOfStreet(const std::string& name) {
-    const fs::path dir = Temp(name);
+    const fs::path dir = Scratch(name);
     fs::copy(StreetMap(), dir, fs::copy_options::recursive);
     fs::remove(dir / "writer.lock");
     return dir;
@@ -78,7 +95,7 @@ TEST(WallsCli, ReportsTheLeaningFacadeWithTheFixedKeysAndLeavesTheMapWithNoSave)
 
 TEST(WallsCli, WritesReportsPicturesAndGrids) {
     const fs::path map = CopyOfStreet("walls_files");
-    const fs::path out = Temp("walls_out");
+    const fs::path out = Scratch("walls_out");
     fs::create_directories(out);
     const Result r =
         Strata("walls " + map.string() + " --no-save --png " + (out / "w.png").string() +
