@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "strata/walls/Clustering.hpp"
@@ -222,83 +223,75 @@ GroundPlane EstimateGround(const core::VoxelMap& map, const columns::ColumnGrid&
     return ground;
 }
 
-WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
-    config.Validate();
-    if (!map.occupancy) throw std::invalid_argument("walls: the map has no occupancy grid");
-    WallResult result;
-    const double s = map.voxel_size;
-    result.voxel_size = s;
-    const double threshold = config.ransac_threshold_m > 0.0 ? config.ransac_threshold_m : 0.5 * s;
+namespace {
 
-    // 1. Columns and votes.
-    auto t = Clock::now();
-    const int radius = std::max(0, static_cast<int>(std::lround(config.window_m / s / 2.0 - 0.5)));
-    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(map);
-    result.stats.occupied_columns = cols.OccupiedColumns();
+// The stages after voting, sharing the map, the settings and the result being filled.
+class Pipeline {
+public:
+    Pipeline(const core::VoxelMap& map, const WallConfig& config, WallResult& result)
+        : map_(map),
+          config_(config),
+          result_(result),
+          s_(map.voxel_size),
+          threshold_(config.ransac_threshold_m > 0.0 ? config.ransac_threshold_m : 0.5 * s_) {}
+
     // Where a voxel's surface is: the mean of its endpoints (or its centre, for comparison).
-    const auto position = [&](const openvdb::Coord& c) {
-        return config.use_point_means ? map.PointMean(c) : map.VoxelCenter(c);
-    };
-    result.ground = EstimateGround(map, cols, config.seed);
-    if (config.level_to_ground) result.up = result.ground.normal;
-    const columns::ColumnGrid window = cols.Window(radius);
-    const std::vector<openvdb::Coord> candidates =
-        VoteCandidates(map, window, radius, config, &result.stats.voting_columns);
-    result.stats.candidate_voxels = candidates.size();
-    result.stats.seconds_columns = Seconds(t);
-
-    // 2. DBSCAN, then K-means inside each cluster.
-    t = Clock::now();
-    const std::vector<int> cluster_of =
-        Dbscan(candidates, config.dbscan_eps_voxels, config.dbscan_min_points);
-    int clusters = 0;
-    for (int c : cluster_of) clusters = std::max(clusters, c + 1);
-    result.stats.clusters = static_cast<size_t>(clusters);
-    std::vector<std::vector<openvdb::Coord>> members(static_cast<size_t>(clusters));
-    for (size_t n = 0; n < candidates.size(); ++n) {
-        if (cluster_of[n] == kNoise) {
-            ++result.stats.noise_voxels;
-        } else {
-            members[cluster_of[n]].push_back(candidates[n]);
-        }
+    [[nodiscard]] Eigen::Vector3d Position(const openvdb::Coord& c) const {
+        return config_.use_point_means ? map_.PointMean(c) : map_.VoxelCenter(c);
     }
-    struct PartVoxels {
-        int cluster;
-        std::vector<openvdb::Coord> voxels;
-    };
-    std::vector<PartVoxels> parts;
-    for (int c = 0; c < clusters; ++c) {
-        const auto& voxels = members[c];
+    [[nodiscard]] std::vector<Eigen::Vector3d> Positions(
+        const std::vector<openvdb::Coord>& voxels) const {
         std::vector<Eigen::Vector3d> points(voxels.size());
-        for (size_t n = 0; n < voxels.size(); ++n) points[n] = position(voxels[n]);
-        const int k = PartsFor(voxels.size(), config.kmeans_divisor);
-        const std::vector<int> part_of = KMeans(points, k, config.seed + c);
-        std::vector<PartVoxels> local(static_cast<size_t>(k), PartVoxels{c, {}});
-        for (size_t n = 0; n < voxels.size(); ++n) local[part_of[n]].voxels.push_back(voxels[n]);
-        for (auto& p : local) {
-            if (!p.voxels.empty()) parts.push_back(std::move(p));
-        }
+        for (size_t n = 0; n < voxels.size(); ++n) points[n] = Position(voxels[n]);
+        return points;
     }
-    result.stats.seconds_clustering = Seconds(t);
 
-    // 3. Per part: RANSAC, then the wall tests on the inliers.
-    t = Clock::now();
-    std::vector<Piece> pieces;
-    for (size_t p = 0; p < parts.size(); ++p) {
-        const auto& voxels = parts[p].voxels;
+    // DBSCAN over the candidates, then K-means inside each cluster: the parts.
+    [[nodiscard]] std::vector<std::pair<int, std::vector<openvdb::Coord>>> Parts(
+        const std::vector<openvdb::Coord>& candidates) {
+        const std::vector<int> cluster_of =
+            Dbscan(candidates, config_.dbscan_eps_voxels, config_.dbscan_min_points);
+        int clusters = 0;
+        for (int c : cluster_of) clusters = std::max(clusters, c + 1);
+        result_.stats.clusters = static_cast<size_t>(clusters);
+        std::vector<std::vector<openvdb::Coord>> members(static_cast<size_t>(clusters));
+        for (size_t n = 0; n < candidates.size(); ++n) {
+            if (cluster_of[n] == kNoise) {
+                ++result_.stats.noise_voxels;
+            } else {
+                members[cluster_of[n]].push_back(candidates[n]);
+            }
+        }
+        std::vector<std::pair<int, std::vector<openvdb::Coord>>> parts;
+        for (int c = 0; c < clusters; ++c) {
+            const auto& voxels = members[c];
+            const int k = PartsFor(voxels.size(), config_.kmeans_divisor);
+            const std::vector<int> part_of = KMeans(Positions(voxels), k, config_.seed + c);
+            std::vector<std::vector<openvdb::Coord>> local(static_cast<size_t>(k));
+            for (size_t n = 0; n < voxels.size(); ++n) local[part_of[n]].push_back(voxels[n]);
+            for (auto& p : local) {
+                if (!p.empty()) parts.emplace_back(c, std::move(p));
+            }
+        }
+        return parts;
+    }
+
+    // RANSAC on one part, then the wall tests on its inliers; a part that passes becomes a
+    // piece of a wall.
+    void Judge(int cluster, const std::vector<openvdb::Coord>& voxels, uint64_t seed,
+               std::vector<Piece>& pieces) {
         WallPart part;
-        part.cluster = parts[p].cluster;
+        part.cluster = cluster;
         part.voxels = voxels.size();
-        part.dominant_class = DominantClass(map, voxels);
-        std::vector<Eigen::Vector3d> points(voxels.size());
-        for (size_t n = 0; n < voxels.size(); ++n) points[n] = position(voxels[n]);
-        if (voxels.size() < config.min_part_voxels) {
+        part.dominant_class = DominantClass(map_, voxels);
+        if (voxels.size() < config_.min_part_voxels) {
             part.verdict = PartVerdict::kTooSmall;
-            result.parts.push_back(part);
-            continue;
+            result_.parts.push_back(part);
+            return;
         }
+        const std::vector<Eigen::Vector3d> points = Positions(voxels);
         const RansacResult ransac =
-            RansacPlane(points, threshold, config.ransac_iterations, config.seed + p);
+            RansacPlane(points, threshold_, config_.ransac_iterations, seed);
         std::vector<Eigen::Vector3d> inliers;
         inliers.reserve(ransac.inliers);
         Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -310,59 +303,71 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
         }
         part.inliers = inliers.size();
         part.eigen_ratio = XyEigenRatio(inliers);
-        part.slant_deg = SlantDeg(ransac.plane.normal, result.up);
-        part.height_m = inliers.empty() ? 0.0 : hi.z() - lo.z() + s;
-        part.length_m = HorizontalExtent(inliers, ransac.plane.normal) + s;
+        part.slant_deg = SlantDeg(ransac.plane.normal, result_.up);
+        part.height_m = inliers.empty() ? 0.0 : hi.z() - lo.z() + s_;
+        part.length_m = HorizontalExtent(inliers, ransac.plane.normal) + s_;
         for (const auto& q : inliers) part.centroid += q;
         if (!inliers.empty()) part.centroid /= static_cast<double>(inliers.size());
-        if (inliers.size() < config.min_inlier_fraction * static_cast<double>(points.size()) ||
+        if (inliers.size() < config_.min_inlier_fraction * static_cast<double>(points.size()) ||
             inliers.size() < 3) {
             part.verdict = PartVerdict::kNotPlanar;
-        } else if (part.slant_deg < config.min_slant_deg) {
+        } else if (part.slant_deg < config_.min_slant_deg) {
             part.verdict = PartVerdict::kNotSteep;
-        } else if (part.eigen_ratio < config.min_eigen_ratio) {
+        } else if (part.eigen_ratio < config_.min_eigen_ratio) {
             part.verdict = PartVerdict::kNotLineLike;
-        } else if (part.height_m < config.min_part_height_m) {
+        } else if (part.height_m < config_.min_part_height_m) {
             part.verdict = PartVerdict::kTooLow;
-        } else if (part.length_m < config.min_part_length_m) {
+        } else if (part.length_m < config_.min_part_length_m) {
             part.verdict = PartVerdict::kTooNarrow;
         } else {
             part.verdict = PartVerdict::kWall;
             // Merging compares planes, so each piece gets the robust fit too: a RANSAC plane of
             // a facade with deep windows can be off by degrees.
             Piece piece{part.cluster, ransac.plane, part.centroid, lo, hi, voxels, points, 0};
-            if (config.refine) piece.plane = RefinePlane(inliers, ransac.plane, 0.25 * threshold);
-            for (const auto& q : points)
-                piece.inliers += std::abs(piece.plane.Distance(q)) <= threshold;
+            if (config_.refine) {
+                piece.plane = RefinePlane(inliers, ransac.plane, 0.25 * threshold_);
+            }
+            for (const auto& q : points) {
+                piece.inliers += std::abs(piece.plane.Distance(q)) <= threshold_;
+            }
             pieces.push_back(std::move(piece));
         }
-        result.parts.push_back(part);
+        result_.parts.push_back(part);
     }
 
-    // 4. Merge coplanar neighbouring pieces, then fit each wall once on all its voxels.
-    UnionFind groups(pieces.size());
-    const double cos_merge = std::cos(config.merge_angle_deg * M_PI / 180.0);
-    for (size_t a = 0; a < pieces.size(); ++a) {
-        for (size_t b = a + 1; b < pieces.size(); ++b) {
-            const Piece& pa = pieces[a];
-            const Piece& pb = pieces[b];
-            if (std::abs(pa.plane.normal.dot(pb.plane.normal)) < cos_merge) continue;
-            if (BoxGap(pa, pb) > config.merge_gap_m) continue;
-            if (std::max(Support(pa, pb, threshold), Support(pb, pa, threshold)) <
-                config.merge_support) {
-                continue;
+    // Groups of pieces that are one wall: close normals, close boxes, and one piece's plane
+    // holding the other's voxels nearly as well as its own.
+    [[nodiscard]] std::vector<std::vector<size_t>> Merge(const std::vector<Piece>& pieces) const {
+        UnionFind groups(pieces.size());
+        const double cos_merge = std::cos(config_.merge_angle_deg * M_PI / 180.0);
+        for (size_t a = 0; a < pieces.size(); ++a) {
+            for (size_t b = a + 1; b < pieces.size(); ++b) {
+                const Piece& pa = pieces[a];
+                const Piece& pb = pieces[b];
+                if (std::abs(pa.plane.normal.dot(pb.plane.normal)) < cos_merge) continue;
+                if (BoxGap(pa, pb) > config_.merge_gap_m) continue;
+                if (std::max(Support(pa, pb, threshold_), Support(pb, pa, threshold_)) <
+                    config_.merge_support) {
+                    continue;
+                }
+                groups.Join(static_cast<int>(a), static_cast<int>(b));
             }
-            groups.Join(static_cast<int>(a), static_cast<int>(b));
         }
+        std::vector<std::vector<size_t>> members(pieces.size());
+        for (size_t a = 0; a < pieces.size(); ++a) {
+            members[groups.Find(static_cast<int>(a))].push_back(a);
+        }
+        members.erase(
+            std::remove_if(members.begin(), members.end(), [](const auto& g) { return g.empty(); }),
+            members.end());
+        return members;
     }
-    auto hits = map.hits->getConstAccessor();
-    std::vector<std::vector<size_t>> members_of(pieces.size());
-    for (size_t a = 0; a < pieces.size(); ++a)
-        members_of[groups.Find(static_cast<int>(a))].push_back(a);
-    for (const auto& group : members_of) {
-        if (group.empty()) continue;
-        // One plane for the whole wall: RANSAC on all its parts' voxels (a part's own plane may
-        // be off), then the weighted robust fit below.
+
+    // One plane for a whole wall: RANSAC on all its pieces' voxels (a piece's own plane may be
+    // off), then the robust fit, each voxel mean weighed by the endpoints it stands for.
+    // Empty when too little is left or the wall is too short.
+    [[nodiscard]] std::optional<Wall> Fit(const std::vector<Piece>& pieces,
+                                          const std::vector<size_t>& group) const {
         std::vector<openvdb::Coord> voxels;
         std::vector<Eigen::Vector3d> points;
         for (size_t a : group) {
@@ -370,64 +375,107 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
             points.insert(points.end(), pieces[a].points.begin(), pieces[a].points.end());
         }
         Plane plane =
-            RansacPlane(points, threshold, config.ransac_iterations, config.seed + group[0]).plane;
-        // Each voxel mean stands for its endpoints: weigh it by their number.
+            RansacPlane(points, threshold_, config_.ransac_iterations, config_.seed + group[0])
+                .plane;
+        auto hits = map_.hits->getConstAccessor();
         std::vector<Eigen::Vector3d> near;
         std::vector<double> weights;
-        for (const auto& c : voxels) {
-            const Eigen::Vector3d p = position(c);
-            if (std::abs(plane.Distance(p)) > threshold) continue;
-            near.push_back(p);
-            weights.push_back(std::max(1, hits.getValue(c)));
+        for (size_t n = 0; n < voxels.size(); ++n) {
+            if (std::abs(plane.Distance(points[n])) > threshold_) continue;
+            near.push_back(points[n]);
+            weights.push_back(std::max(1, hits.getValue(voxels[n])));
         }
-        if (near.size() < 3) continue;
-        plane = config.refine ? RefinePlane(near, plane, 0.25 * threshold, weights)
-                              : FitPlane(near, weights).plane;
+        if (near.size() < 3) return std::nullopt;
+        plane = config_.refine ? RefinePlane(near, plane, 0.25 * threshold_, weights)
+                               : FitPlane(near, weights).plane;
         Wall wall;
-        std::vector<Eigen::Vector3d> final_points;
-        for (const auto& c : voxels) {
-            const Eigen::Vector3d p = position(c);
-            if (std::abs(plane.Distance(p)) <= threshold) {
-                final_points.push_back(p);
-                wall.voxels.push_back(c);
-            }
+        std::vector<Eigen::Vector3d> inliers;
+        for (size_t n = 0; n < voxels.size(); ++n) {
+            if (std::abs(plane.Distance(points[n])) > threshold_) continue;
+            inliers.push_back(points[n]);
+            wall.voxels.push_back(voxels[n]);
         }
-        if (final_points.size() < 3) continue;
-        PlaneFit fit = FitPlane(final_points);
+        if (inliers.size() < 3) return std::nullopt;
+        PlaneFit fit = FitPlane(inliers);
         double sum2 = 0.0;
-        for (const auto& p : final_points) sum2 += plane.Distance(p) * plane.Distance(p);
+        for (const auto& p : inliers) sum2 += plane.Distance(p) * plane.Distance(p);
         fit.plane = plane;
-        fit.rms = std::sqrt(sum2 / static_cast<double>(final_points.size()));
-        wall.normal = TowardsObservedSide(map, wall.voxels, plane.normal);
+        fit.rms = std::sqrt(sum2 / static_cast<double>(inliers.size()));
+        wall.normal = TowardsObservedSide(map_, wall.voxels, plane.normal);
         wall.d = wall.normal.dot(plane.normal) > 0 ? plane.d : -plane.d;
         wall.centroid = fit.centroid;
-        wall.inliers = final_points.size();
+        wall.inliers = inliers.size();
         wall.rms_m = fit.rms;
-        wall.slant_deg = SlantDeg(wall.normal, result.up);
-        wall.slant_to_ground_deg = SlantDeg(wall.normal, result.ground.normal);
-        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal, result.up);
+        wall.slant_deg = SlantDeg(wall.normal, result_.up);
+        wall.slant_to_ground_deg = SlantDeg(wall.normal, result_.ground.normal);
+        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal, result_.up);
         // The fit's own one-sigma treats voxels as independent and misses what windows and
-        // recesses do; the spread of the parts' own slants catches that (robustly: MAD).
-        std::vector<double> part_slants;
-        for (size_t a : group) part_slants.push_back(SlantDeg(pieces[a].plane.normal, result.up));
-        wall.uncertainty_deg = std::max(SlantUncertaintyDeg(fit), SpreadOfMean(part_slants));
-        wall.eigen_ratio = XyEigenRatio(final_points);
+        // recesses do; the spread of the pieces' own slants catches that (robustly: MAD).
+        std::vector<double> piece_slants;
+        for (size_t a : group) piece_slants.push_back(SlantDeg(pieces[a].plane.normal, result_.up));
+        wall.uncertainty_deg = std::max(SlantUncertaintyDeg(fit), SpreadOfMean(piece_slants));
+        wall.eigen_ratio = XyEigenRatio(inliers);
         wall.parts = static_cast<int>(group.size());
         // A plane crosses about (|nx| + |ny| + |nz|) voxels per voxel face of its area.
-        wall.area_m2 = static_cast<double>(wall.inliers) * s * s / wall.normal.cwiseAbs().sum();
+        wall.area_m2 = static_cast<double>(wall.inliers) * s_ * s_ / wall.normal.cwiseAbs().sum();
         const Eigen::Vector3d along = Eigen::Vector3d::UnitZ().cross(wall.normal).normalized();
         const Eigen::Vector3d up = wall.normal.cross(along).normalized();
         double a_lo = 1e300, a_hi = -1e300, z_lo = 1e300, z_hi = -1e300;
-        for (const auto& p : final_points) {
+        for (const auto& p : inliers) {
             a_lo = std::min(a_lo, p.dot(along));
             a_hi = std::max(a_hi, p.dot(along));
             z_lo = std::min(z_lo, p.dot(up));
             z_hi = std::max(z_hi, p.dot(up));
         }
-        wall.length_m = a_hi - a_lo + s;
-        wall.height_m = z_hi - z_lo + s;
-        if (wall.length_m < config.min_wall_length_m) continue;
-        result.walls.push_back(std::move(wall));
+        wall.length_m = a_hi - a_lo + s_;
+        wall.height_m = z_hi - z_lo + s_;
+        if (wall.length_m < config_.min_wall_length_m) return std::nullopt;
+        return wall;
+    }
+
+private:
+    const core::VoxelMap& map_;
+    const WallConfig& config_;
+    WallResult& result_;
+    double s_;
+    double threshold_;
+};
+
+}  // namespace
+
+WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
+    config.Validate();
+    if (!map.occupancy) throw std::invalid_argument("walls: the map has no occupancy grid");
+    WallResult result;
+    const double s = map.voxel_size;
+    result.voxel_size = s;
+    Pipeline pipeline(map, config, result);
+
+    // 1. Column statistics, the ground and the votes.
+    auto t = Clock::now();
+    const int radius = std::max(0, static_cast<int>(std::lround(config.window_m / s / 2.0 - 0.5)));
+    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(map);
+    result.stats.occupied_columns = cols.OccupiedColumns();
+    result.ground = EstimateGround(map, cols, config.seed);
+    if (config.level_to_ground) result.up = result.ground.normal;
+    const std::vector<openvdb::Coord> candidates =
+        VoteCandidates(map, cols.Window(radius), radius, config, &result.stats.voting_columns);
+    result.stats.candidate_voxels = candidates.size();
+    result.stats.seconds_columns = Seconds(t);
+
+    // 2. DBSCAN, then K-means inside each cluster.
+    t = Clock::now();
+    const auto parts = pipeline.Parts(candidates);
+    result.stats.seconds_clustering = Seconds(t);
+
+    // 3. The wall tests per part, merging, one fit per wall.
+    t = Clock::now();
+    std::vector<Piece> pieces;
+    for (size_t p = 0; p < parts.size(); ++p) {
+        pipeline.Judge(parts[p].first, parts[p].second, config.seed + p, pieces);
+    }
+    for (const auto& group : pipeline.Merge(pieces)) {
+        if (auto wall = pipeline.Fit(pieces, group)) result.walls.push_back(std::move(*wall));
     }
     std::sort(result.walls.begin(), result.walls.end(),
               [](const Wall& a, const Wall& b) { return a.inliers > b.inliers; });
