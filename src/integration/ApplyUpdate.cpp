@@ -39,23 +39,28 @@ void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const Integra
     // the leaf buffers; groups come sorted, so consecutive groups mostly share a leaf.
     openvdb::Int32Tree& hits = map.hits->tree();
     hits.topologyUnion(*update.occupied);
-    // The mean endpoint position follows the counts: m' = (m n + sum) / (n + k).
+    // The mean endpoint position follows the counts, m' = (m n + sum) / (n + k), in the leaf
+    // with the same origin in `point_mean`, activated the same way.
+    openvdb::Vec3STree& means = map.point_mean->tree();
+    means.topologyUnion(*update.occupied);
+    const double half = 0.5 * map.voxel_size;
     openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
-    auto mean = map.point_mean->getAccessor();
+    openvdb::Vec3STree::LeafNodeType* mean_leaf = nullptr;
     for (const EndpointGroup& g : update.endpoints) {
         const openvdb::Coord origin(g.ijk.x() & ~7, g.ijk.y() & ~7, g.ijk.z() & ~7);
-        if (!leaf || origin != leaf->origin()) leaf = hits.probeLeaf(g.ijk);
-        int32_t& count = leaf->buffer().data()[leaf->coordToOffset(g.ijk)];
-        const openvdb::Vec3s m = mean.getValue(g.ijk);
+        if (!leaf || origin != leaf->origin()) {
+            leaf = hits.probeLeaf(g.ijk);
+            mean_leaf = means.probeLeaf(g.ijk);
+        }
+        const openvdb::Index offset = leaf->coordToOffset(g.ijk);
+        int32_t& count = leaf->buffer().data()[offset];
+        openvdb::Vec3s& mean = mean_leaf->buffer().data()[offset];
         const double before = count;
         count += g.points;
-        const double half = 0.5 * map.voxel_size;
-        openvdb::Vec3s updated;
         for (int a = 0; a < 3; ++a) {
-            const double v = (m[a] * before + g.offset_sum[a]) / count;
-            updated[a] = static_cast<float>(std::clamp(v, -half, half));
+            const double v = (mean[a] * before + g.offset_sum[a]) / count;
+            mean[a] = static_cast<float>(std::clamp(v, -half, half));
         }
-        mean.setValue(g.ijk, updated);
     }
 
     auto label = map.label->getAccessor();

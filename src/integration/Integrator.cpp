@@ -13,42 +13,36 @@
 namespace strata::integration {
 namespace {
 
-// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted;
-// then adds each point's offset from its voxel centre to its group (found by binary search).
+// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted
+// with the point's index alongside, so each group also sums its points' offsets from the centre.
 std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
                                           const core::Scan& scan) {
-    const auto key_of = [&](size_t i) {
+    const size_t n = prepared.endpoint_pos.size();
+    std::vector<uint64_t> keys(n);
+    std::vector<uint32_t> points(prepared.endpoint_point.begin(), prepared.endpoint_point.end());
+    for (size_t i = 0; i < n; ++i) {
         const auto label = scan.has_labels() ? scan.labels[prepared.endpoint_point[i]]
                                              : core::SemanticClass::kUnknown;
-        return (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
-               static_cast<uint64_t>(label);
-    };
-    std::vector<uint64_t> keys(prepared.endpoint_pos.size());
-    for (size_t i = 0; i < keys.size(); ++i) keys[i] = key_of(i);
+        keys[i] = (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
+                  static_cast<uint64_t>(label);
+    }
     int key_bits = 8;  // class id
     while ((int64_t{1} << (key_bits - 8)) < prepared.box.size()) ++key_bits;
-    detail::RadixSort(keys, key_bits);
+    detail::RadixSort(keys, key_bits, points);
     std::vector<EndpointGroup> groups;
-    std::vector<uint64_t> unique;  // the key of each group
     const detail::VoxelBox& box = prepared.box;
-    for (size_t i = 0; i < keys.size();) {
-        size_t j = i;
-        while (j < keys.size() && keys[j] == keys[i]) ++j;
-        groups.push_back(EndpointGroup{box.CoordOf(static_cast<int64_t>(keys[i] >> 8)),
-                                       static_cast<int32_t>(j - i),
-                                       static_cast<core::SemanticClass>(keys[i] & 0xff),
-                                       Eigen::Vector3d::Zero()});
-        unique.push_back(keys[i]);
-        i = j;
-    }
-    for (size_t i = 0; i < prepared.endpoint_pos.size(); ++i) {
-        const size_t g = static_cast<size_t>(
-            std::lower_bound(unique.begin(), unique.end(), key_of(i)) - unique.begin());
-        const openvdb::Coord& c = groups[g].ijk;
+    for (size_t i = 0; i < n;) {
+        EndpointGroup g;
+        g.ijk = box.CoordOf(static_cast<int64_t>(keys[i] >> 8));
+        g.label = static_cast<core::SemanticClass>(keys[i] & 0xff);
         const Eigen::Vector3d centre =
-            (Eigen::Vector3d(c.x(), c.y(), c.z()) + Eigen::Vector3d::Constant(0.5)) *
+            (Eigen::Vector3d(g.ijk.x(), g.ijk.y(), g.ijk.z()) + Eigen::Vector3d::Constant(0.5)) *
             prepared.voxel_size;
-        groups[g].offset_sum += prepared.ends[prepared.endpoint_point[i]] - centre;
+        size_t j = i;
+        for (; j < n && keys[j] == keys[i]; ++j) g.offset_sum += prepared.ends[points[j]] - centre;
+        g.points = static_cast<int32_t>(j - i);
+        groups.push_back(g);
+        i = j;
     }
     return groups;
 }
