@@ -41,8 +41,8 @@ void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const Integra
     hits.topologyUnion(*update.occupied);
     // The mean endpoint position follows the counts, m' = (m n + sum) / (n + k), in the leaf
     // with the same origin in `point_mean`, activated the same way.
-    openvdb::Vec3STree& means = map.point_mean->tree();
-    means.topologyUnion(*update.occupied);
+    openvdb::Vec3STree* means = config.keep_point_means ? &map.point_mean->tree() : nullptr;
+    if (means) means->topologyUnion(*update.occupied);
     const double half = 0.5 * map.voxel_size;
     openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
     openvdb::Vec3STree::LeafNodeType* mean_leaf = nullptr;
@@ -50,13 +50,14 @@ void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const Integra
         const openvdb::Coord origin(g.ijk.x() & ~7, g.ijk.y() & ~7, g.ijk.z() & ~7);
         if (!leaf || origin != leaf->origin()) {
             leaf = hits.probeLeaf(g.ijk);
-            mean_leaf = means.probeLeaf(g.ijk);
+            if (means) mean_leaf = means->probeLeaf(g.ijk);
         }
         const openvdb::Index offset = leaf->coordToOffset(g.ijk);
         int32_t& count = leaf->buffer().data()[offset];
-        openvdb::Vec3s& mean = mean_leaf->buffer().data()[offset];
         const double before = count;
         count += g.points;
+        if (!means) continue;
+        openvdb::Vec3s& mean = mean_leaf->buffer().data()[offset];
         for (int a = 0; a < 3; ++a) {
             const double v = (mean[a] * before + g.offset_sum[a]) / count;
             mean[a] = static_cast<float>(std::clamp(v, -half, half));

@@ -13,13 +13,15 @@
 namespace strata::integration {
 namespace {
 
-// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted
-// with the point's index alongside, so each group also sums its points' offsets from the centre.
+// Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted;
+// with `offsets`, the point's index rides along so each group also sums its points' offsets
+// from the voxel centre.
 std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
-                                          const core::Scan& scan) {
+                                          const core::Scan& scan, bool offsets) {
     const size_t n = prepared.endpoint_pos.size();
     std::vector<uint64_t> keys(n);
-    std::vector<uint32_t> points(prepared.endpoint_point.begin(), prepared.endpoint_point.end());
+    std::vector<uint32_t> points;
+    if (offsets) points.assign(prepared.endpoint_point.begin(), prepared.endpoint_point.end());
     for (size_t i = 0; i < n; ++i) {
         const auto label = scan.has_labels() ? scan.labels[prepared.endpoint_point[i]]
                                              : core::SemanticClass::kUnknown;
@@ -39,7 +41,9 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
             (Eigen::Vector3d(g.ijk.x(), g.ijk.y(), g.ijk.z()) + Eigen::Vector3d::Constant(0.5)) *
             prepared.voxel_size;
         size_t j = i;
-        for (; j < n && keys[j] == keys[i]; ++j) g.offset_sum += prepared.ends[points[j]] - centre;
+        for (; j < n && keys[j] == keys[i]; ++j) {
+            if (offsets) g.offset_sum += prepared.ends[points[j]] - centre;
+        }
         g.points = static_cast<int32_t>(j - i);
         groups.push_back(g);
         i = j;
@@ -72,7 +76,7 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
     ScanUpdate update;
     detail::ScanMasks masks;
     tbb::parallel_invoke([&] { masks = detail::MarkScan(prepared, config); },
-                         [&] { update.endpoints = GroupEndpoints(prepared, scan); });
+                         [&] { update.endpoints = GroupEndpoints(prepared, scan, config.keep_point_means); });
     update.free = masks.free;
     update.occupied = masks.occupied;
     update.points = scan.points.size();

@@ -132,6 +132,15 @@ TEST(Integrator, KeepsTheMeanEndpointOfEachVoxelAcrossScans) {
     EXPECT_TRUE(map.PointMean({4, 0, 0}).isApprox(Eigen::Vector3d(2.2, 0.3, 0.25), kTol));
     // A voxel with no endpoint has no mean: its centre stands in.
     EXPECT_FALSE(map.point_mean->tree().isValueOn({2, 0, 0}));
+    // Without point means, everything else is the same and the grid stays empty.
+    core::VoxelMap lean = core::VoxelMap::Create(0.5);
+    IntegrationConfig config;
+    config.keep_point_means = false;
+    Integrator lean_integrator(lean, config);
+    lean_integrator.Integrate(MakeScan({{2.1, 0.2, 0.3}, {2.3, 0.4, 0.1}}, origin));
+    EXPECT_EQ(lean.hits->tree().getValue({4, 0, 0}), 2);
+    EXPECT_TRUE(lean.point_mean->empty());
+    EXPECT_TRUE(lean.PointMean({4, 0, 0}).isApprox(lean.VoxelCenter({4, 0, 0})));
 }
 
 TEST(Integrator, ClampsLogOddsLikeOctomap) {

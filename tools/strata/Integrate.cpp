@@ -147,6 +147,11 @@ void RegisterIntegrate(CLI::App& app) {
     cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->capture_default_str();
     cmd->add_flag("--points-only", args->config.points_only,
                   "Endpoints only, no free space (clouds without a sensor origin)");
+    cmd->add_flag(
+        "--no-point-means",
+        [args](int64_t) { args->config.keep_point_means = false; },
+        "Do not keep each voxel's mean endpoint (faster, half the memory; wall slants then "
+        "fall back to voxel centres)");
     cmd->callback([args, cmd] { Run(*args, *cmd); });
 }
 
