@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "strata/core/Scan.hpp"
@@ -32,6 +34,24 @@ inline std::vector<core::Scan> LoadKittiScans(
         scans.push_back(io::ReadKittiScan(seq, i));
     }
     return scans;
+}
+
+/// `PROGRAM [DATA_DIR] [--repeat N]`: the arguments of the benchmarks that repeat a measurement.
+struct RepeatArgs {
+    std::filesystem::path data;
+    int repeat = 5;
+};
+inline RepeatArgs ParseRepeatArgs(int argc, char** argv, const std::filesystem::path& data) {
+    RepeatArgs args{data, 5};
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--repeat" && i + 1 < argc) {
+            args.repeat = std::max(1, std::atoi(argv[++i]));
+        } else {
+            args.data = arg;
+        }
+    }
+    return args;
 }
 
 }  // namespace strata::bench

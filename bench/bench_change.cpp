@@ -101,18 +101,9 @@ int Run(const fs::path& data, int repeat) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    fs::path data = STRATA_DATA_DIR;
-    int repeat = 5;
-    for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        if (arg == "--repeat" && i + 1 < argc) {
-            repeat = std::max(1, std::atoi(argv[++i]));
-        } else {
-            data = arg;
-        }
-    }
+    const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
     try {
-        return Run(data, repeat);
+        return Run(args.data, args.repeat);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_change: %s\n", e.what());
         return EXIT_FAILURE;

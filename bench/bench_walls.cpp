@@ -79,17 +79,8 @@ int Run(const fs::path& data, int repeat) {
 
 int main(int argc, char** argv) {
     try {
-        fs::path data = STRATA_DATA_DIR;
-        int repeat = 5;
-        for (int i = 1; i < argc; ++i) {
-            const std::string arg = argv[i];
-            if (arg == "--repeat" && i + 1 < argc) {
-                repeat = std::max(1, std::atoi(argv[++i]));
-            } else {
-                data = arg;
-            }
-        }
-        return Run(data, repeat);
+        const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
+        return Run(args.data, args.repeat);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_walls: %s\n", e.what());
         return 1;

@@ -22,16 +22,9 @@ double ValueOf(const ColumnStat& s, ColumnValue value) {
 
 // Heat ramp for t in [0, 1]: dark blue, red, yellow, white.
 core::Rgb Heat(double t) {
-    static constexpr core::Rgb kStops[] = {
+    static const std::vector<core::Rgb> kStops = {
         {20, 20, 90}, {200, 30, 30}, {250, 210, 30}, {255, 255, 255}};
-    t = std::clamp(t, 0.0, 1.0) * 3.0;
-    const int k = std::min(2, static_cast<int>(t));
-    const double f = t - k;
-    const auto mix = [&](uint8_t a, uint8_t b) {
-        return static_cast<uint8_t>(std::lround(a + (b - a) * f));
-    };
-    return {mix(kStops[k].r, kStops[k + 1].r), mix(kStops[k].g, kStops[k + 1].g),
-            mix(kStops[k].b, kStops[k + 1].b)};
+    return io::Ramp(kStops, t);
 }
 
 }  // namespace

@@ -67,6 +67,19 @@ void DrawText(RgbImage& image, int x0, int y0, const std::string& text, int scal
 
 }  // namespace
 
+core::Rgb Ramp(const std::vector<core::Rgb>& stops, double t) {
+    if (stops.size() < 2) throw std::invalid_argument("a colour ramp needs at least 2 stops");
+    const int last = static_cast<int>(stops.size()) - 1;
+    const double x = std::clamp(t, 0.0, 1.0) * last;
+    const int k = std::min(last - 1, static_cast<int>(x));
+    const double f = x - k;
+    const auto mix = [&](uint8_t a, uint8_t b) {
+        return static_cast<uint8_t>(std::lround(a + (b - a) * f));
+    };
+    return {mix(stops[k].r, stops[k + 1].r), mix(stops[k].g, stops[k + 1].g),
+            mix(stops[k].b, stops[k + 1].b)};
+}
+
 void DrawLabel(RgbImage& image, int x, int y, const std::string& text, int scale) {
     DrawText(image, x, y, text, scale);
 }

@@ -126,16 +126,9 @@ std::string WallsCsv(const WallResult& result) {
 
 core::Rgb SlantColor(double slant_deg, double max_deviation_deg) {
     // Blue (vertical) -> green -> yellow -> red (max deviation or more).
-    static constexpr core::Rgb kStops[] = {
+    static const std::vector<core::Rgb> kStops = {
         {40, 110, 255}, {40, 200, 80}, {255, 220, 0}, {230, 30, 30}};
-    const double t = std::clamp((90.0 - slant_deg) / max_deviation_deg, 0.0, 1.0) * 3.0;
-    const int k = std::min(2, static_cast<int>(t));
-    const double f = t - k;
-    const auto mix = [&](uint8_t a, uint8_t b) {
-        return static_cast<uint8_t>(std::lround(a + (b - a) * f));
-    };
-    return {mix(kStops[k].r, kStops[k + 1].r), mix(kStops[k].g, kStops[k + 1].g),
-            mix(kStops[k].b, kStops[k + 1].b)};
+    return io::Ramp(kStops, (90.0 - slant_deg) / max_deviation_deg);
 }
 
 void WriteWallsPng(const core::VoxelMap& map, const WallResult& result,

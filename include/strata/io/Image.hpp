@@ -44,6 +44,10 @@ private:
 /// @param meters_per_pixel ground size of one pixel; must be positive.
 void DrawScaleBar(RgbImage& image, double meters_per_pixel);
 
+/// @brief A colour ramp through `stops` (at least 2, evenly spaced) at t in [0, 1] (clamped),
+/// linear between neighbouring stops.
+[[nodiscard]] core::Rgb Ramp(const std::vector<core::Rgb>& stops, double t);
+
 /// @brief Draws white text in a 5-pixel-high bitmap font scaled by `scale` with its top-left
 /// corner at (x, y), clipped to the image. The font has digits, '.', ' ' and 'm' only (labels
 /// of scale bars and legends); other characters draw as blanks.
