@@ -26,6 +26,7 @@ void IntegrationConfig::Validate() const {
             "clamp probabilities must satisfy 0 < min < 0.5 < max < 1");
     Require(std::isfinite(label_vote_weight) && label_vote_weight > 0.0f,
             "label_vote_weight must be positive");
+    Require(max_update_bytes > 0, "max_update_bytes must be positive");
 }
 
 }  // namespace strata::integration

@@ -5,6 +5,8 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <stdexcept>
 
 #include "ApplyUpdate.hpp"
 #include "RadixSort.hpp"
@@ -25,8 +27,8 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
     for (size_t i = 0; i < n; ++i) {
         const auto label = scan.has_labels() ? scan.labels[prepared.endpoint_point[i]]
                                              : core::SemanticClass::kUnknown;
-        keys[i] = (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) |
-                  static_cast<uint64_t>(label);
+        keys[i] =
+            (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) | static_cast<uint64_t>(label);
     }
     int key_bits = 8;  // class id
     while ((int64_t{1} << (key_bits - 8)) < prepared.box.size()) ++key_bits;
@@ -51,6 +53,39 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
     return groups;
 }
 
+// Refuses an update whose new leaves would grow the map's grids by more than the budget: every
+// new leaf of the observed voxels costs an occupancy leaf, every new endpoint leaf also a hits,
+// point-mean, label and label-weight leaf.
+void RequireUpdateFits(const ScanUpdate& update, const core::VoxelMap& map,
+                       const IntegrationConfig& config) {
+    const auto& occupancy = map.occupancy->tree();
+    size_t new_observed = 0, new_endpoint = 0;
+    for (auto leaf = update.free->cbeginLeaf(); leaf; ++leaf) {
+        new_observed += occupancy.probeConstLeaf(leaf->origin()) == nullptr;
+    }
+    for (auto leaf = update.occupied->cbeginLeaf(); leaf; ++leaf) {
+        const bool fresh = occupancy.probeConstLeaf(leaf->origin()) == nullptr;
+        new_observed += fresh && !update.free->probeConstLeaf(leaf->origin());
+        new_endpoint += fresh;
+    }
+    constexpr size_t kObservedLeaf = sizeof(openvdb::FloatTree::LeafNodeType);
+    constexpr size_t kEndpointLeaf = sizeof(openvdb::Int32Tree::LeafNodeType) * 2 +
+                                     sizeof(openvdb::FloatTree::LeafNodeType) +
+                                     sizeof(openvdb::Vec3STree::LeafNodeType);
+    const double bytes = static_cast<double>(new_observed) * kObservedLeaf +
+                         static_cast<double>(new_endpoint) * kEndpointLeaf;
+    if (bytes > static_cast<double>(config.max_update_bytes)) {
+        char text[320];
+        std::snprintf(text, sizeof(text),
+                      "this scan would grow the map by %.1f GB (%zu new leaves of 8^3 voxels at "
+                      "%.3g m), more than the %.1f GB one scan may add: use a larger voxel size "
+                      "or a shorter max range",
+                      bytes / 1e9, new_observed, map.voxel_size,
+                      static_cast<double>(config.max_update_bytes) / 1e9);
+        throw std::runtime_error(text);
+    }
+}
+
 }  // namespace
 
 ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
@@ -61,8 +96,7 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
 
     // Map frame = world frame shifted by the map's georeferenced origin.
     std::vector<Eigen::Vector3d> points_map(scan.points.size());
-    const Eigen::Isometry3d T_map_sensor =
-        Eigen::Translation3d(-map.origin) * scan.T_world_sensor;
+    const Eigen::Isometry3d T_map_sensor = Eigen::Translation3d(-map.origin) * scan.T_world_sensor;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points_map.size(), 8192),
                       [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i != r.end(); ++i) {
@@ -75,10 +109,12 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
     // Grouping endpoints (serial) runs beside the parallel ray marking.
     ScanUpdate update;
     detail::ScanMasks masks;
-    tbb::parallel_invoke([&] { masks = detail::MarkScan(prepared, config); },
-                         [&] { update.endpoints = GroupEndpoints(prepared, scan, config.keep_point_means); });
+    tbb::parallel_invoke(
+        [&] { masks = detail::MarkScan(prepared, config); },
+        [&] { update.endpoints = GroupEndpoints(prepared, scan, config.keep_point_means); });
     update.free = masks.free;
     update.occupied = masks.occupied;
+    RequireUpdateFits(update, map, config);
     update.points = scan.points.size();
     update.dropped = prepared.dropped;
     update.clipped = prepared.clipped;

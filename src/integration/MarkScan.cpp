@@ -4,9 +4,13 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <stdexcept>
+#include <unordered_set>
 
 #include "RayMarking.hpp"
 
@@ -71,7 +75,6 @@ inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark) {
 }
 
 size_t RayCount(const PreparedScan& scan) { return scan.points_only ? 0 : scan.ends.size(); }
-
 
 // One 8x8x8 brick of a bitmap as the eight 64-bit words of a VDB leaf mask (offset x<<6|y<<3|z:
 // word = x, byte = y, bit = z), which is the bitmap's byte layout since z is fastest.
@@ -173,10 +176,68 @@ ScanMasks MarkSparse(const PreparedScan& scan) {
 
 }  // namespace
 
+void RequireSparseMarkingFits(const PreparedScan& scan, const IntegrationConfig& config) {
+    // What a VDB tree pays for the voxels rays cross: a leaf per 8^3 block (~2 kB for a float
+    // grid, plus the marking masks) and an internal node per 128^3 block (16^3 child slots,
+    // ~33 kB, in each of ~8 trees). At 1 cm a leaf is 8 cm and a node 1.28 m wide: long rays
+    // through fresh space cost far more than the voxels suggest. Bound the cost before marking:
+    // first without sharing between rays (cheap), then, only if that bound is over budget, by
+    // counting the blocks the rays enter (sampled every half leaf, stopping at the budget).
+    constexpr double kBytesPerLeaf = 2.5 * 1024.0;
+    constexpr double kBytesPerNode = 8.0 * 33.0 * 1024.0;
+    const double budget = static_cast<double>(config.max_update_bytes);
+    const double s = scan.voxel_size;
+    const auto cost = [&](double leaves, double nodes) {
+        return leaves * kBytesPerLeaf + nodes * kBytesPerNode;
+    };
+    double leaves_bound = 0.0, nodes_bound = 0.0;
+    for (size_t i = 0; i < scan.ends.size(); ++i) {
+        if (scan.kinds[i] == PointKind::kDropped) continue;
+        const double length = (scan.ends[i] - scan.origin).norm() / s;  // voxels
+        leaves_bound += length / 8.0 + 2.0;
+        nodes_bound += length / 128.0 + 2.0;
+    }
+    if (cost(leaves_bound, nodes_bound) <= budget) return;
+
+    std::unordered_set<uint64_t> leaves, nodes;
+    const auto key = [&](const Eigen::Vector3d& p, int shift) {
+        const auto b = [&](double v) {
+            return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v / s)) >> shift) &
+                   0x1fffff;
+        };
+        return b(p.x()) << 42 | b(p.y()) << 21 | b(p.z());
+    };
+    const double step = 4.0 * s;  // half a leaf
+    for (size_t i = 0; i < scan.ends.size(); ++i) {
+        if (scan.kinds[i] == PointKind::kDropped) continue;
+        const Eigen::Vector3d d = scan.ends[i] - scan.origin;
+        const double length = d.norm();
+        for (double t = 0.0;; t = std::min(length, t + step)) {
+            const Eigen::Vector3d p = scan.origin + (length > 0.0 ? t / length : 0.0) * d;
+            leaves.insert(key(p, 3));
+            nodes.insert(key(p, 7));
+            if (t >= length) break;
+        }
+        const double bytes =
+            cost(static_cast<double>(leaves.size()), static_cast<double>(nodes.size()));
+        if (bytes > budget) {
+            char text[320];
+            std::snprintf(text, sizeof(text),
+                          "this scan's rays cross over %zu leaves (8^3 voxels) at %.3g m: more "
+                          "than %.1f GB of tree nodes, the most one scan may add: use a larger "
+                          "voxel size or a shorter max range",
+                          leaves.size(), s, budget / 1e9);
+            throw std::runtime_error(text);
+        }
+    }
+}
+
 ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config) {
     if (static_cast<uint64_t>(scan.box.size() / 8) <= config.dense_scratch_limit_bytes) {
         return MarkDense(scan);
     }
+    // Only a scan too large for the dense scratch can be too large for memory.
+    RequireSparseMarkingFits(scan, config);
     return MarkSparse(scan);
 }
 

@@ -76,6 +76,23 @@ TEST(Cli, FailedIntegrationLeavesTheMapUntouched) {
                      "--frames 0:2").code, 0);
 }
 
+TEST(Cli, AScanTooFineForMemoryIsRefusedNamingIt) {
+    // A 100 m hall at 1 cm voxels: every ray crosses thousands of fresh leaves, far over the
+    // per-scan budget (IntegrationConfig::max_update_bytes); refused before the memory goes, and
+    // no map is left behind.
+    strata::tools::test::SequenceSpec spec;
+    spec.scans = 1;
+    spec.room_half_m = Eigen::Vector3d(50.0, 40.0, 5.0);
+    const fs::path seq = MakeSequence(Temp("seq_fine"), spec);
+    const fs::path map = Temp("map_fine");
+    const Result r =
+        Strata("integrate " + map.string() + " --kitti " + seq.string() + " --voxel 0.01");
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find("000000.bin"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("larger voxel size"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(map / "catalog.sqlite")) << "no map is left behind";
+}
+
 TEST(Cli, IntegratesTextScansWithAPoseFile) {
     const fs::path dir = Temp("text");
     fs::create_directories(dir);

@@ -27,8 +27,8 @@ std::pair<size_t, size_t> ParseFrames(const std::string& text, size_t n) {
         if (begin < end && end <= n) return {begin, end};
     } catch (const std::logic_error&) {
     }
-    throw std::invalid_argument("--frames '" + text + "': expected A:B with 0 <= A < B <= " +
-                                std::to_string(n));
+    throw std::invalid_argument("--frames '" + text +
+                                "': expected A:B with 0 <= A < B <= " + std::to_string(n));
 }
 
 }  // namespace
@@ -73,7 +73,14 @@ std::string ScanSource::Describe() const {
 void IntegrateScans(store::SessionWriter& writer, const ScanSource& source) {
     Progress progress("integrating", source.size());
     for (size_t i = 0; i < source.size(); ++i) {
-        (void)writer.Integrate(source.Read(i));
+        const core::Scan scan = source.Read(i);  // reader errors name their file already
+        try {
+            (void)writer.Integrate(scan);
+        } catch (const std::exception& e) {
+            // Integration errors (a refused scan, a bad pose) get the scan they are about.
+            throw std::runtime_error("scan " + std::to_string(i) + " (" + scan.source +
+                                     "): " + e.what());
+        }
         progress.Advance();
     }
 }

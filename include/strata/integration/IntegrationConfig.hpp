@@ -21,6 +21,11 @@ struct IntegrationConfig {
     /// one thread: about +35 %; two threads: +4 %). Off: the grid stays empty and analyses fall
     /// back to voxel centres.
     bool keep_point_means = true;
+    /// Largest growth of the map's grids one scan may cause (its new VDB leaves times their size).
+    /// A scan needing more is refused with std::runtime_error before the map changes: fine voxels
+    /// over long rays allocate a 2-8 kB leaf for every 8^3 block a ray crosses (1 cm voxels and
+    /// 20k rays of 40 m: ~20 GB), which would otherwise exhaust memory.
+    size_t max_update_bytes = size_t{2} << 30;
     /// Per-thread budget of the dense scratch bitmap covering one scan's bounding box; scans whose
     /// box needs more are marked sparsely (slower, bounded memory).
     size_t dense_scratch_limit_bytes = size_t{64} << 20;
