@@ -1,0 +1,71 @@
+// Stage 1 of the wall pipeline: which voxels are wall candidates (column windows that vote), and
+// the ground plane the slants may be measured against.
+#include <cmath>
+#include <vector>
+
+#include "strata/walls/Walls.hpp"
+
+namespace strata::walls {
+
+std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
+                                           const columns::ColumnGrid& window, int radius,
+                                           const WallConfig& config, size_t* voting_columns) {
+    const double s = map.voxel_size;
+    const double side_m = (2 * radius + 1) * s;
+    const int clearance = static_cast<int>(std::ceil(config.ground_clearance_m / s - 1e-9));
+    auto votes = [&](const columns::ColumnStat& w) {
+        return w.voxels > 0 && w.voxels * s * s / side_m >= config.min_wall_height_m &&
+               w.extent_voxels() * s >= config.min_wall_height_m &&
+               w.points >= config.min_window_points;
+    };
+    if (voting_columns) {
+        *voting_columns = 0;
+        for (int j = window.min_j(); j < window.min_j() + window.height(); ++j) {
+            for (int i = window.min_i(); i < window.min_i() + window.width(); ++i) {
+                *voting_columns += votes(window.At(i, j));
+            }
+        }
+    }
+    std::vector<openvdb::Coord> candidates;
+    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.0f) continue;
+        openvdb::CoordBBox box;
+        it.getBoundingBox(box);
+        for (auto v = box.begin(); v; ++v) {
+            const openvdb::Coord& ijk = *v;
+            const columns::ColumnStat& w = window.At(ijk.x(), ijk.y());
+            if (votes(w) && ijk.z() >= w.k_min + clearance) candidates.push_back(ijk);
+        }
+    }
+    return candidates;
+}
+
+GroundPlane EstimateGround(const core::VoxelMap& map, const columns::ColumnGrid& columns,
+                           uint64_t seed) {
+    constexpr size_t kMaxColumns = 50000;  // a sample is plenty for one plane
+    std::vector<Eigen::Vector3d> lowest;
+    for (int j = 0; j < columns.height(); ++j) {
+        for (int i = 0; i < columns.width(); ++i) {
+            const openvdb::Coord column(columns.min_i() + i, columns.min_j() + j, 0);
+            const columns::ColumnStat& c = columns.At(column.x(), column.y());
+            if (c.voxels > 0) lowest.push_back(map.PointMean(column.offsetBy(0, 0, c.k_min)));
+        }
+    }
+    GroundPlane ground;
+    if (lowest.size() < 3) return ground;
+    if (lowest.size() > kMaxColumns) {
+        std::vector<Eigen::Vector3d> sample;
+        const double step = static_cast<double>(lowest.size()) / kMaxColumns;
+        for (size_t k = 0; k < kMaxColumns; ++k) {
+            sample.push_back(lowest[static_cast<size_t>(static_cast<double>(k) * step)]);
+        }
+        lowest.swap(sample);
+    }
+    const RansacResult r = RansacPlane(lowest, map.voxel_size, 200, seed);
+    ground.normal = r.plane.normal.z() < 0.0 ? Eigen::Vector3d(-r.plane.normal) : r.plane.normal;
+    ground.tilt_deg = SlantDeg(ground.normal);  // 0 for a level ground
+    ground.columns = r.inliers;
+    return ground;
+}
+
+}  // namespace strata::walls
