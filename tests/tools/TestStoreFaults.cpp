@@ -461,6 +461,45 @@ TEST(StoreFaults, FullDiskFailsAndLeavesTheMapAsItWas) {
     }
 }
 
+// `strata ARGS` with fsync/fdatasync failing with EIO on every file whose path holds `on`.
+Result StrataWithEio(const std::string& on, const std::string& args) {
+    const std::string cmd = "STRATA_EIO_ON='" + on + "' LD_PRELOAD='" + STRATA_EIO_SHIM + "' '" +
+                            STRATA_BINARY + "' " + args + " 2>&1";
+    Result r;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    char buf[4096];
+    while (pipe && std::fgets(buf, sizeof buf, pipe)) r.out += buf;
+    const int status = pipe ? ::pclose(pipe) : -1;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+// A disk that reports an I/O error when the data is flushed: on a new tile file, and on the
+// catalog. Either way the command fails naming what it could not write, and the map stays the
+// map of the sessions before, checks clean, and takes the next session.
+TEST(StoreFaults, IoErrorsOnFlushFailTheCommitAndLeaveTheMap) {
+    const Fixture f = MakeMap("faults_eio", 1);
+    const auto files_before = MapFiles(f.map);
+    const VoxelMap map_before = LoadLatest(f.map);
+    for (const auto& [on, named] :
+         {std::pair<std::string, std::string>{"/tiles/", "Input/output error"},
+          std::pair<std::string, std::string>{"catalog.sqlite",
+                                              "catalog.sqlite: disk I/O error"}}) {
+        const Result r = StrataWithEio(on, Join(IntegrateArgs(f.map, f.seq, 2)));
+        EXPECT_NE(r.code, 0) << on << ": " << r.out;
+        EXPECT_NE(r.out.find(named), std::string::npos) << on << ": " << r.out;
+        EXPECT_NE(r.out.find(f.map.string()), std::string::npos) << on << ": " << r.out;
+        EXPECT_EQ(SessionCount(f.map), 1u) << on;
+        EXPECT_TRUE(SameMap(LoadLatest(f.map), map_before)) << on;
+        EXPECT_EQ(MapFiles(f.map), files_before) << on;
+        const Result check = Strata("check " + f.map.string() + " --json");
+        EXPECT_EQ(check.code, 0) << check.out;
+    }
+    const Result next = Strata(Join(IntegrateArgs(f.map, f.seq, 2)));
+    EXPECT_EQ(next.code, 0) << next.out;
+    EXPECT_EQ(SessionCount(f.map), 2u);
+}
+
 // A map without write permission bits is read-only for strata even for root: writes are refused
 // with a message, reads work, nothing changes.
 TEST(StoreFaults, ReadOnlyMapRefusesWritersAndServesReaders) {
