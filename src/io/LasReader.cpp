@@ -13,7 +13,7 @@ namespace strata::io {
 namespace {
 
 // Offsets in the public header block (ASPRS LAS 1.4 R15, table 3; 1.0-1.3 share the first 227).
-constexpr size_t kVersionAt = 24, kHeaderSizeAt = 94, kPointFormatAt = 104;
+constexpr size_t kVersionAt = 24, kHeaderSizeAt = 94;  // the point format follows at 104
 constexpr size_t kScaleAt = 131, kCount64At = 247;
 constexpr size_t kMinHeaderSize = 227, kHeader14Size = 375;
 // Minimum point record length of formats 0-10 (extra bytes may follow).
