@@ -1,6 +1,8 @@
 #include "EmbreeScene.hpp"
 
+#include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -12,7 +14,57 @@ namespace {
     throw std::runtime_error("Embree: " + what + " (error " + std::to_string(int(code)) + ")");
 }
 
+// Closest point of triangle abc to p, by the Voronoi region of p (vertex, edge or face).
+Eigen::Vector3f ClosestOnTriangle(const Eigen::Vector3f& p, const Eigen::Vector3f& a,
+                                  const Eigen::Vector3f& b, const Eigen::Vector3f& c) {
+    const Eigen::Vector3f ab = b - a, ac = c - a, ap = p - a;
+    const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    const Eigen::Vector3f bp = p - b;
+    const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    const float vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+    const Eigen::Vector3f cp = p - c;
+    const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    const float vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+    const float va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+    }
+    const float denom = 1.0F / (va + vb + vc);
+    return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// Point-query callback: shrinks the search radius to the closest triangle seen so far.
+bool ClosestTriangle(RTCPointQueryFunctionArguments* args) {
+    auto* scene = static_cast<RTCScene>(args->userPtr);
+    RTCGeometry geom = rtcGetGeometry(scene, args->geomID);
+    const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    const auto* t = static_cast<const uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+    const uint32_t* tri = t + 3 * args->primID;
+    auto vertex = [&](uint32_t k) { return Eigen::Vector3f(v[3 * k], v[3 * k + 1], v[3 * k + 2]); };
+    const Eigen::Vector3f p(args->query->x, args->query->y, args->query->z);
+    const float d = (ClosestOnTriangle(p, vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) - p).norm();
+    if (d >= args->query->radius) return false;
+    args->query->radius = d;
+    return true;
+}
+
 }  // namespace
+
+float EmbreeScene::ClosestDistance(const Eigen::Vector3f& point, float max_radius) const {
+    RTCPointQuery query{};
+    query.x = point.x(), query.y = point.y(), query.z = point.z();
+    query.radius = max_radius;
+    query.time = 0.0F;
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(scene_, &query, &context, ClosestTriangle, scene_);
+    return query.radius < max_radius ? query.radius : std::numeric_limits<float>::infinity();
+}
 
 EmbreeScene::EmbreeScene(const std::vector<Mesh>& meshes) {
     device_ = rtcNewDevice("verbose=0");

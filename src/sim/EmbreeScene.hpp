@@ -37,6 +37,10 @@ public:
     void Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3f* direction, int count,
                     float t_far, Hit* hits) const;
 
+    /// Distance from `point` to the nearest triangle, searched within `max_radius`; infinity
+    /// when none is that near (Embree point query, exact closest point on each triangle).
+    [[nodiscard]] float ClosestDistance(const Eigen::Vector3f& point, float max_radius) const;
+
 private:
     [[noreturn]] void Fail(const std::string& what);  // releases, then throws runtime_error
     void Release() noexcept;

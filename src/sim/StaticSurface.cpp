@@ -50,7 +50,10 @@ SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m, uint64_t
 }
 
 void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
-                  const std::vector<Eigen::Vector3d>& origins_world, double max_range_m) {
+                  const std::vector<Eigen::Vector3d>& origins_world, double max_range_m,
+                  double min_elevation_deg, double max_elevation_deg) {
+    const double sin_min = std::sin(min_elevation_deg * M_PI / 180.0);
+    const double sin_max = std::sin(max_elevation_deg * M_PI / 180.0);
     sample.observed.assign(sample.points.size(), 0);
     // Range: points; each point tries its nearest origins and stops at the first that sees it.
     tbb::parallel_for(
@@ -69,6 +72,8 @@ void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
                     const Eigen::Vector3d d = sample.points[i] - o;
                     const double dist = d.norm();
                     if (dist > max_range_m || dist < 1e-6) break;
+                    const double sin_elevation = d.z() / dist;
+                    if (sin_elevation < sin_min || sin_elevation > sin_max) continue;
                     // Stop just short of the point: it lies on its own surface.
                     if (!simulator.CastRay(o, d, dist - 0.02)) {
                         sample.observed[i] = 1;

@@ -26,9 +26,12 @@ struct SurfaceSample {
                                                 uint64_t seed);
 
 /// @brief Sets `observed` for points with a free line of sight from one of their 8 nearest
-/// origins within max_range_m (the sensor's field of view is not modelled). Parallel (TBB).
+/// origins within max_range_m and, seen from that origin, at an elevation inside
+/// [min_elevation_deg, max_elevation_deg] (a level sensor's vertical field of view; the
+/// defaults do not limit it). Parallel (TBB).
 void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
-                  const std::vector<Eigen::Vector3d>& origins_world, double max_range_m);
+                  const std::vector<Eigen::Vector3d>& origins_world, double max_range_m,
+                  double min_elevation_deg = -90.0, double max_elevation_deg = 90.0);
 
 /// @brief Writes a binary little-endian PLY (x y z float, label instance ushort, observed
 /// uchar), points mapped by T_out_world. Throws std::runtime_error naming the file on failure.

@@ -1,0 +1,258 @@
+// Vehicle candidates (labels or the geometric detector), touching cars split, boxes fitted.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "strata/core/Labels.hpp"
+#include "strata/vehicles/VehicleStages.hpp"
+#include "strata/walls/Clustering.hpp"
+
+namespace strata::vehicles {
+
+namespace {
+
+using core::SemanticClass;
+
+bool IsLabel(int32_t value, SemanticClass c) { return value == static_cast<int32_t>(c); }
+
+// A voxel of an object: where its points lay and how high above the ground.
+struct Sample {
+    Eigen::Vector2d xy;
+    double z = 0.0;
+    double h = 0.0;  // above the ground; NaN when the column has none
+};
+
+std::vector<Sample> Samples(const core::VoxelMap& map, const GroundField& ground,
+                            const std::vector<openvdb::Coord>& voxels) {
+    std::vector<Sample> out;
+    out.reserve(voxels.size());
+    for (const openvdb::Coord& c : voxels) {
+        const Eigen::Vector3d p = map.PointMean(c);
+        out.push_back({p.head<2>(), p.z(), p.z() - ground.Height(c.x(), c.y())});
+    }
+    return out;
+}
+
+// Seen length along the rectangle's axis of the samples in a height band.
+double BandLength(const std::vector<Sample>& samples, const OrientedRect& rect, double lo,
+                  double hi) {
+    double min = std::numeric_limits<double>::max(), max = -min;
+    for (const Sample& s : samples) {
+        if (!(s.h >= lo && s.h <= hi)) continue;
+        const double t = s.xy.dot(rect.Axis());
+        min = std::min(min, t), max = std::max(max, t);
+    }
+    return max >= min ? max - min : 0.0;
+}
+
+Eigen::Vector2d NearestOrigin(const std::vector<Eigen::Vector3d>& origins,
+                              const Eigen::Vector2d& p) {
+    Eigen::Vector2d best = p;
+    double best_d = std::numeric_limits<double>::max();
+    for (const Eigen::Vector3d& o : origins) {
+        const double d = (o.head<2>() - p).squaredNorm();
+        if (d < best_d) best_d = d, best = o.head<2>();
+    }
+    return best;
+}
+
+// Columns of a part that rise well above its roof over a small footprint, and their
+// neighbours: what a pillar seen next to a car adds to it (its top is out of the sensor's
+// view from near by, so the structure band cannot catch it).
+std::set<std::pair<int, int>> Towers(const std::vector<openvdb::Coord>& object,
+                                     const std::vector<Sample>& samples,
+                                     const std::vector<size_t>& members,
+                                     const VehicleConfig& config) {
+    std::map<std::pair<int, int>, double> top;
+    for (size_t i : members) {
+        if (std::isnan(samples[i].h)) continue;
+        auto [it, added] = top.emplace(std::make_pair(object[i].x(), object[i].y()), samples[i].h);
+        if (!added) it->second = std::max(it->second, samples[i].h);
+    }
+    std::set<std::pair<int, int>> towers;
+    if (top.empty()) return towers;
+    std::vector<double> tops;
+    for (const auto& [column, h] : top) tops.push_back(h);
+    std::nth_element(tops.begin(), tops.begin() + tops.size() / 2, tops.end());
+    const double roof = tops[tops.size() / 2];
+    std::vector<std::pair<int, int>> tall;
+    for (const auto& [column, h] : top) {
+        if (h > roof + config.tower_margin_m) tall.push_back(column);
+    }
+    if (tall.empty() || tall.size() > config.max_tower_columns) return towers;
+    for (const auto& [i, j] : tall) {
+        for (int dj = -1; dj <= 1; ++dj) {
+            for (int di = -1; di <= 1; ++di) towers.insert({i + di, j + dj});
+        }
+    }
+    return towers;
+}
+
+// k - 1 cuts along one axis: at the emptiest voxel-wide bin (the gap between two cars, a
+// pillar between them at most) within a third of a part of each even division.
+std::vector<double> Cuts(const std::vector<double>& t, int k, double bin) {
+    std::vector<double> cuts;
+    if (k <= 1 || t.empty()) return cuts;
+    const auto [lo_it, hi_it] = std::minmax_element(t.begin(), t.end());
+    const double lo = *lo_it, hi = *hi_it;
+    std::vector<size_t> count(size_t((hi - lo) / bin) + 1, 0);
+    for (double v : t) ++count[size_t((v - lo) / bin)];
+    const double part = (hi - lo) / k;
+    for (int c = 1; c < k; ++c) {
+        const double target = lo + c * part;
+        size_t best = size_t((target - lo) / bin);
+        for (size_t i = 0; i < count.size(); ++i) {
+            const double centre = lo + (i + 0.5) * bin;
+            if (std::abs(centre - target) > part / 3) continue;
+            const double d_i = std::abs(centre - target);
+            const double d_best = std::abs(lo + (best + 0.5) * bin - target);
+            if (count[i] < count[best] || (count[i] == count[best] && d_i < d_best)) best = i;
+        }
+        cuts.push_back(lo + (best + 0.5) * bin);
+    }
+    return cuts;
+}
+
+}  // namespace
+
+ObjectSet FindObjects(const core::VoxelMap& map, const GroundField& ground, VehicleSource source,
+                      const VehicleConfig& config) {
+    ObjectSet set;
+    set.source = source;
+    set.kept = openvdb::MaskGrid::create();
+    set.kept->setTransform(map.occupancy->transform().copy());
+    auto kept = set.kept->getAccessor();
+    auto label = map.label->getConstAccessor();
+    // Geometric: columns reaching into the structure band hold no vehicle (a car parked against
+    // a pillar would otherwise join it into one object taller than any car).
+    openvdb::MaskGrid structure;
+    auto structure_acc = structure.getAccessor();
+    if (source == VehicleSource::kGeometric) {
+        for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+            if (*it <= 0.0F || !it.isVoxelValue()) continue;
+            const openvdb::Coord c = it.getCoord();
+            const double h = map.PointMean(c).z() - ground.Height(c.x(), c.y());
+            if (h >= config.structure_min_m && h <= config.structure_max_m) {
+                structure_acc.setValueOn(openvdb::Coord(c.x(), c.y(), 0));
+            }
+        }
+    }
+    std::vector<openvdb::Coord> voxels;
+    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.0F || !it.isVoxelValue()) continue;
+        const openvdb::Coord c = it.getCoord();
+        const double h = map.PointMean(c).z() - ground.Height(c.x(), c.y());
+        const bool above = h >= config.min_voxel_height_m && h <= config.max_voxel_height_m;
+        if (source == VehicleSource::kLabel) {
+            const int32_t l = label.getValue(c);
+            if (IsLabel(l, SemanticClass::kVehicle)) {
+                voxels.push_back(c);
+            } else if (above && !IsLabel(l, SemanticClass::kUnknown)) {
+                kept.setValueOn(c);  // labelled as something else: never cleared
+            }
+        } else if (above && structure_acc.isValueOn(openvdb::Coord(c.x(), c.y(), 0))) {
+            kept.setValueOn(c);
+        } else if (above) {
+            voxels.push_back(c);
+        }
+    }
+    const double eps = std::max(1.75, 1.0 + config.gap_m / map.voxel_size);
+    const std::vector<int> cluster = walls::Dbscan(voxels, eps, 1);
+    std::map<int, std::vector<openvdb::Coord>> groups;
+    for (size_t i = 0; i < voxels.size(); ++i) groups[cluster[i]].push_back(voxels[i]);
+    for (auto& [id, group] : groups) {
+        if (group.size() >= config.min_voxels) set.objects.push_back(std::move(group));
+    }
+    return set;
+}
+
+std::vector<VehicleObject> FitVehicles(const core::VoxelMap& map, const GroundField& ground,
+                                       const std::vector<openvdb::Coord>& object,
+                                       VehicleSource source,
+                                       const std::vector<Eigen::Vector3d>& origins_map,
+                                       const VehicleConfig& config) {
+    std::vector<VehicleObject> out;
+    if (object.size() < std::max<size_t>(config.min_voxels, 2)) return out;
+    const std::vector<Sample> samples = Samples(map, ground, object);
+    std::vector<Eigen::Vector2d> xy;
+    for (const Sample& s : samples) xy.push_back(s.xy);
+    const OrientedRect whole = FitLShape(xy, config.heading_step_deg);
+
+    // Step 1: touching cars, one object too long or too wide for a car, cut along its axes.
+    const int k_length = whole.length > config.max_length_m
+                             ? std::max(1, int(std::lround(whole.length / config.split_length_m)))
+                             : 1;
+    const int k_width = whole.width > config.max_width_m
+                            ? std::max(1, int(std::lround(whole.width / config.split_width_m)))
+                            : 1;
+    const Eigen::Vector2d a = whole.Axis(), b(-a.y(), a.x());
+    std::vector<double> along, across;
+    for (const Sample& s : samples) along.push_back(s.xy.dot(a)), across.push_back(s.xy.dot(b));
+    const std::vector<double> cuts_a = Cuts(along, k_length, map.voxel_size);
+    const std::vector<double> cuts_b = Cuts(across, k_width, map.voxel_size);
+    auto slot = [](const std::vector<double>& cuts, double t) {
+        return int(std::upper_bound(cuts.begin(), cuts.end(), t) - cuts.begin());
+    };
+    std::vector<int> part(object.size(), 0);
+    for (size_t i = 0; i < object.size(); ++i) {
+        part[i] = slot(cuts_a, along[i]) * k_width + slot(cuts_b, across[i]);
+    }
+    const int parts = k_length * k_width;
+
+    // Step 2: per part, the L-shape, the car it is, and (geometric) whether it looks like one.
+    for (int p = 0; p < parts; ++p) {
+        VehicleObject v;
+        std::vector<Sample> mine;
+        std::vector<Eigen::Vector2d> mine_xy;
+        std::vector<size_t> members;
+        for (size_t i = 0; i < object.size(); ++i) {
+            if (part[i] == p) members.push_back(i);
+        }
+        const std::set<std::pair<int, int>> towers = source == VehicleSource::kGeometric
+                                                         ? Towers(object, samples, members, config)
+                                                         : std::set<std::pair<int, int>>{};
+        for (size_t i : members) {
+            if (towers.count({object[i].x(), object[i].y()})) continue;
+            v.voxels.push_back(object[i]);
+            mine.push_back(samples[i]);
+            mine_xy.push_back(samples[i].xy);
+        }
+        if (mine.size() < std::max<size_t>(config.min_voxels, 2)) continue;
+        Vehicle& car = v.vehicle;
+        car.source = source;
+        car.voxels = mine.size();
+        car.seen = FitLShape(mine_xy, config.heading_step_deg);
+        car.footprint =
+            ExtendToCarSize(car.seen, NearestOrigin(origins_map, car.seen.center), config.car);
+        const openvdb::Coord centre = map.WorldToVoxel(
+            Eigen::Vector3d(car.footprint.center.x(), car.footprint.center.y(), 0.0));
+        double base = std::numeric_limits<double>::max(), top = -base, z_min = base;
+        for (const Sample& s : mine) {
+            z_min = std::min(z_min, s.z);
+            if (std::isnan(s.h)) continue;
+            base = std::min(base, s.h), top = std::max(top, s.h);
+        }
+        car.ground_z = ground.Height(centre.x(), centre.y());
+        if (std::isnan(car.ground_z)) car.ground_z = z_min - 0.5 * map.voxel_size;
+        car.height = top > base ? top + 0.5 * map.voxel_size : 0.0;
+        for (const Sample& s : mine) {
+            car.height = std::max(car.height, s.z - car.ground_z + 0.5 * map.voxel_size);
+        }
+        if (source == VehicleSource::kGeometric) {
+            const double band = BandLength(mine, car.seen, 0.3, 1.0);
+            const bool car_like = car.seen.length >= config.min_seen_length_m &&
+                                  car.footprint.length <= config.max_length_m &&
+                                  car.footprint.width <= config.max_width_m &&
+                                  top >= config.min_top_m && top <= config.max_top_m &&
+                                  base <= config.max_base_m &&
+                                  band >= config.min_low_band_fraction * car.seen.length;
+            if (!car_like) continue;
+        }
+        out.push_back(std::move(v));
+    }
+    return out;
+}
+
+}  // namespace strata::vehicles

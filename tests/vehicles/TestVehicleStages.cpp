@@ -1,0 +1,209 @@
+// Each stage of the vehicle pipeline on geometry with a known answer.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "strata/core/Labels.hpp"
+#include "strata/vehicles/VehicleStages.hpp"
+
+namespace strata::vehicles {
+namespace {
+
+using core::SemanticClass;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kVoxel = 0.1;
+constexpr double kYawToleranceDeg = 1.0;
+constexpr double kSideToleranceM = 0.1;
+constexpr double kRefillHeightToleranceM = 0.01;
+
+// A map with helpers to write occupied or free voxels at a point.
+struct TestMap {
+    core::VoxelMap map = core::VoxelMap::Create(kVoxel);
+
+    void Occupy(const Eigen::Vector3d& p, SemanticClass c) {
+        const openvdb::Coord ijk = map.WorldToVoxel(p);
+        map.occupancy->tree().setValue(ijk, 2.0F);
+        map.label->tree().setValue(ijk, static_cast<int32_t>(c));
+        map.label_weight->tree().setValue(ijk, 1.0F);
+        map.hits->tree().setValue(ijk, 1);
+        const Eigen::Vector3d offset = p - map.VoxelCenter(ijk);
+        map.point_mean->tree().setValue(
+            ijk, openvdb::Vec3s(float(offset.x()), float(offset.y()), float(offset.z())));
+    }
+    void Free(const Eigen::Vector3d& p) {
+        map.occupancy->tree().setValue(map.WorldToVoxel(p), -2.0F);
+    }
+    [[nodiscard]] bool Occupied(const Eigen::Vector3d& p) const {
+        return map.occupancy->tree().getValue(map.WorldToVoxel(p)) > 0.0F;
+    }
+    // Ground z = slope * x over [x0, x1] x [y0, y1], one point per column.
+    void Ground(double x0, double x1, double y0, double y1, double slope, SemanticClass c) {
+        for (double x = x0 + 0.05; x < x1; x += kVoxel) {
+            for (double y = y0 + 0.05; y < y1; y += kVoxel) Occupy({x, y, 0.02 + slope * x}, c);
+        }
+    }
+    // The shell of an axis-aligned car body [x0, x1] x [y0, y1] x [z0, z1] (sides and roof).
+    void Body(double x0, double x1, double y0, double y1, double z0, double z1, SemanticClass c) {
+        for (double x = x0 + 0.05; x < x1; x += kVoxel) {
+            for (double y = y0 + 0.05; y < y1; y += kVoxel) {
+                for (double z = z0 + 0.05; z < z1; z += kVoxel) {
+                    const bool side = x < x0 + kVoxel || x > x1 - kVoxel || y < y0 + kVoxel ||
+                                      y > y1 - kVoxel || z > z1 - kVoxel;
+                    if (side) Occupy({x, y, z}, c);
+                }
+            }
+        }
+    }
+};
+
+TEST(LShapeFit, RecoversTheHeadingAndSidesOfAKnownL) {
+    // Two sides of a 4.5 m x 1.8 m rectangle at 30 degrees, 2 cm noise, as a scanner sees a car.
+    const double yaw = 30.0 * kPi / 180.0;
+    const Eigen::Vector2d a(std::cos(yaw), std::sin(yaw)), b(-a.y(), a.x());
+    const Eigen::Vector2d corner(3.0, -2.0);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, 0.02);
+    std::vector<Eigen::Vector2d> points;
+    for (double t = 0.0; t <= 4.5; t += 0.05) points.push_back(corner + t * a + noise(rng) * b);
+    for (double t = 0.05; t <= 1.8; t += 0.05) points.push_back(corner + t * b + noise(rng) * a);
+    const OrientedRect r = FitLShape(points);
+    EXPECT_NEAR(r.yaw_rad * 180.0 / kPi, 30.0, kYawToleranceDeg);
+    EXPECT_NEAR(r.length, 4.5, kSideToleranceM);
+    EXPECT_NEAR(r.width, 1.8, kSideToleranceM);
+    EXPECT_LT((r.center - (corner + 2.25 * a + 0.9 * b)).norm(), kSideToleranceM);
+    EXPECT_THROW((void)FitLShape({Eigen::Vector2d::Zero()}), std::invalid_argument);
+}
+
+TEST(LShapeFit, BirdsEyeIoUOfKnownRectangles) {
+    OrientedRect a;
+    a.length = 4.0, a.width = 2.0;
+    OrientedRect b = a;
+    EXPECT_NEAR(BirdsEyeIoU(a, b), 1.0, 1e-12);
+    b.center = {2.0, 0.0};  // half overlaps: 4 / (8 + 8 - 4)
+    EXPECT_NEAR(BirdsEyeIoU(a, b), 4.0 / 12.0, 1e-12);
+    b.center = {0.0, 0.0}, b.yaw_rad = kPi / 2;  // a cross: the 2 x 2 middle
+    EXPECT_NEAR(OverlapArea(a, b), 4.0, 1e-12);
+    b.center = {10.0, 0.0};
+    EXPECT_EQ(OverlapArea(a, b), 0.0);
+}
+
+TEST(LShapeFit, AFrontSeenFromTheAisleGrowsIntoACarAwayFromTheViewer) {
+    // Only the 1.8 m front at y = 0 was seen, from an aisle at y = -5: the car is y in [0, 4.5].
+    OrientedRect seen;
+    seen.center = {0.0, 0.05};
+    seen.length = 1.8;
+    seen.width = 0.1;
+    seen.yaw_rad = 0.0;
+    const OrientedRect car = ExtendToCarSize(seen, {0.0, -5.0});
+    EXPECT_NEAR(car.length, 4.5, 1e-9);
+    EXPECT_NEAR(car.width, 1.8, 1e-9);
+    EXPECT_NEAR(std::abs(car.yaw_rad), kPi / 2, 1e-9);
+    EXPECT_NEAR(car.center.y(), 2.25, 1e-9);  // the seen front edge, y = 0, stays
+}
+
+TEST(RefillGround, FollowsTheSlopeOfTheRingNotOneMeanHeight) {
+    TestMap t;
+    constexpr double kSlope = 0.1;  // a 10 % ramp along x
+    t.Ground(-6.0, 6.0, -6.0, 6.0, kSlope, SemanticClass::kGround);
+    Vehicle car;
+    car.footprint.center = {0.0, 0.0};
+    car.footprint.length = 4.0;
+    car.footprint.width = 2.0;
+    car.ground_z = 0.0;
+    car.height = 1.5;
+    // The vehicle stood here: its ground is unknown (cleared before the refill).
+    for (double x = -2.0 + 0.05; x < 2.0; x += kVoxel) {
+        for (double y = -1.0 + 0.05; y < 1.0; y += kVoxel) {
+            const openvdb::Coord c = t.map.WorldToVoxel({x, y, 0.02 + kSlope * x});
+            t.map.occupancy->tree().setValueOff(c, 0.0F);
+        }
+    }
+    const GroundField ground = GroundField::FromMap(t.map, {});
+    auto refilled = openvdb::FloatGrid::create(0.0F);
+    RefillGround(t.map, car, ground, nullptr, *refilled, {});
+    EXPECT_EQ(car.refilled_cells, 40U * 20U);
+    EXPECT_EQ(car.refused_cells, 0U);
+    EXPECT_NEAR(car.ground_plane[1], kSlope, 0.005);
+    for (auto it = refilled->cbeginValueOn(); it; ++it) {
+        const Eigen::Vector3d c = t.map.VoxelCenter(it.getCoord());
+        ASSERT_NEAR(*it, 0.02 + kSlope * c.x(), kRefillHeightToleranceM) << "at x " << c.x();
+        ASSERT_NEAR(t.map.PointMean(it.getCoord()).z(), *it, 1e-4);
+        ASSERT_EQ(t.map.label->tree().getValue(it.getCoord()),
+                  static_cast<int32_t>(SemanticClass::kGround));
+    }
+}
+
+TEST(RayCheck, AVisibleGapSeenEmptyStaysEmptyWhileCellsTheCarHidFill) {
+    // Flat ground; a drain across x in [0.0, 1.5], seen empty everywhere, also under the car.
+    // The car body (0.3 m above the ground) covers x in [-2, 1.2], its box reaches x = 2; the
+    // sensor stands at x = 6. Drain cells the body hides from the sensor are filled; visible
+    // ones (in front of the body, or seen under its sill) are refused.
+    TestMap t;
+    t.Ground(-8.0, 8.0, -6.0, 6.0, 0.0, SemanticClass::kGround);
+    for (double x = 0.05; x < 1.5; x += kVoxel) {
+        for (double y = -5.95; y < 6.0; y += kVoxel) {
+            t.map.occupancy->tree().setValueOff(t.map.WorldToVoxel({x, y, 0.02}), 0.0F);
+            t.Free({x, y, 0.02});
+            t.Occupy({x, y, -0.8}, SemanticClass::kGround);  // the drain's bottom
+        }
+    }
+    t.Body(-2.0, 1.2, -0.9, 0.9, 0.3, 1.5, SemanticClass::kVehicle);
+    const std::vector<Eigen::Vector3d> origins = {{6.0, 0.0, 1.7}};
+    const GroundField ground = GroundField::FromMap(t.map, {});
+    VehicleConfig config;
+    Eigen::AlignedBox3d region(Eigen::Vector3d(-20, -20, -5), Eigen::Vector3d(20, 20, 5));
+    const RayCheck check(t.map, ground, origins, region, config);
+    EXPECT_GT(check.faces(), 0U);
+    EXPECT_TRUE(check.Visible({1.25, 0.0, 0.02}));   // drain in front of the body
+    EXPECT_FALSE(check.Visible({-1.0, 0.0, 0.02}));  // under the body
+
+    // Remove the body as clearing would, then refill the box x in [-2, 2].
+    for (auto it = t.map.label->cbeginValueOn(); it; ++it) {
+        if (*it == static_cast<int32_t>(SemanticClass::kVehicle)) {
+            t.map.occupancy->tree().setValueOff(it.getCoord(), 0.0F);
+        }
+    }
+    Vehicle car;
+    car.footprint.center = {0.0, 0.0};
+    car.footprint.length = 4.0;
+    car.footprint.width = 1.8;
+    car.height = 1.5;
+    auto refilled = openvdb::FloatGrid::create(0.0F);
+    RefillGround(t.map, car, ground, &check, *refilled, config);
+    EXPECT_GT(car.refused_cells, 0U);
+    EXPECT_FALSE(t.Occupied({1.45, 0.0, 0.02})) << "the visible drain was filled";
+    EXPECT_FALSE(t.Occupied({1.05, 0.0, 0.02})) << "the drain seen under the sill was filled";
+    EXPECT_TRUE(t.Occupied({0.05, 0.0, 0.02})) << "the drain under the body stayed open";
+}
+
+TEST(ClearVehicles, ALabelledCarIsClearedAndItsGroundRefilled) {
+    TestMap t;
+    t.Ground(-8.0, 8.0, -6.0, 6.0, 0.0, SemanticClass::kGround);
+    t.Body(-2.2, 2.2, -0.9, 0.9, 0.3, 1.5, SemanticClass::kVehicle);
+    // The ground under the car was never seen.
+    for (double x = -2.15; x < 2.2; x += kVoxel) {
+        for (double y = -0.85; y < 0.9; y += kVoxel) {
+            t.map.occupancy->tree().setValueOff(t.map.WorldToVoxel({x, y, 0.02}), 0.0F);
+        }
+    }
+    const std::vector<Eigen::Vector3d> origins = {{0.0, -6.0, 1.7}, {5.0, -6.0, 1.7}};
+    const VehicleResult r = ClearVehicles(t.map, origins);
+    EXPECT_EQ(r.source, VehicleSource::kLabel);
+    ASSERT_EQ(r.vehicles.size(), 1U);
+    const Vehicle& v = r.vehicles[0];
+    EXPECT_EQ(v.source, VehicleSource::kLabel);
+    EXPECT_LT((v.footprint.center - Eigen::Vector2d(0.0, 0.0)).norm(), kSideToleranceM);
+    EXPECT_NEAR(v.footprint.length, 4.4, 2 * kSideToleranceM);
+    EXPECT_NEAR(v.footprint.width, 1.8, 2 * kSideToleranceM);
+    EXPECT_GT(v.cleared_voxels, 0U);
+    for (auto it = t.map.label->cbeginValueOn(); it; ++it) {
+        ASSERT_NE(*it, static_cast<int32_t>(SemanticClass::kVehicle)) << it.getCoord();
+    }
+    EXPECT_EQ(v.refilled_cells, 44U * 18U);
+    EXPECT_TRUE(t.Occupied({0.0, 0.0, 0.02}));
+    EXPECT_EQ(r.cleared->activeVoxelCount(), v.cleared_voxels);
+}
+
+}  // namespace
+}  // namespace strata::vehicles
