@@ -75,6 +75,16 @@ VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
     return map;
 }
 
+VoxelMap VoxelMap::DeepCopy() const {
+    VoxelMap copy = *this;
+    copy.occupancy = occupancy ? occupancy->deepCopy() : nullptr;
+    copy.label = label ? label->deepCopy() : nullptr;
+    copy.label_weight = label_weight ? label_weight->deepCopy() : nullptr;
+    copy.hits = hits ? hits->deepCopy() : nullptr;
+    copy.point_mean = point_mean ? point_mean->deepCopy() : nullptr;
+    return copy;
+}
+
 openvdb::GridPtrVec VoxelMap::Grids() const {
     openvdb::GridPtrVec grids{occupancy, label, label_weight, hits, point_mean};
     for (auto& g : grids) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -55,14 +56,15 @@ struct Columns {
 // so every task reads labels through its own accessor.
 class ColumnOp {
 public:
-    ColumnOp(const openvdb::Int32Tree& labels, Columns& columns)
-        : labels_(labels), columns_(&columns) {}
+    ColumnOp(const openvdb::Int32Tree& labels, Columns& columns, int32_t max_k)
+        : labels_(labels), columns_(&columns), max_k_(max_k) {}
     void operator()(const openvdb::FloatGrid::ValueOnCIter& iter) const {
         const bool occupied = *iter > 0.0f;
         openvdb::CoordBBox bbox(iter.getCoord(), iter.getCoord());
         if (!iter.isVoxelValue()) iter.getBoundingBox(bbox);
+        if (bbox.min().z() > max_k_) return;  // above the cut (a ceiling)
         // A tile's top voxel is its highest z: no need to walk the tile in z.
-        const int32_t z = bbox.max().z();
+        const int32_t z = std::min(bbox.max().z(), max_k_);
         for (int32_t x = bbox.min().x(); x <= bbox.max().x(); ++x) {
             for (int32_t y = bbox.min().y(); y <= bbox.max().y(); ++y) {
                 const int64_t key =
@@ -75,6 +77,7 @@ public:
 private:
     openvdb::tree::ValueAccessor<const openvdb::Int32Tree> labels_;
     Columns* columns_;
+    int32_t max_k_;
 };
 
 // A blue-green-yellow-red ramp for t in [0, 1].
@@ -132,7 +135,10 @@ TopDownImage RenderTopDown(const core::VoxelMap& map, const TopDownOptions& opti
 
     // Step 2: the top occupied voxel of every column, in parallel over active voxels and tiles.
     // The op must be a non-const lvalue: tools::foreach shares a const op between threads.
-    ColumnOp op(map.label->tree(), columns);
+    const int32_t max_k =
+        options.max_z_m ? static_cast<int32_t>(std::floor(*options.max_z_m / map.voxel_size))
+                        : std::numeric_limits<int32_t>::max();
+    ColumnOp op(map.label->tree(), columns, max_k);
     openvdb::tools::foreach (map.occupancy->cbeginValueOn(), op, /*threaded=*/true,
                              /*shareOp=*/false);
 

@@ -143,6 +143,27 @@ CREATE TABLE walls (
 );
 CREATE INDEX walls_by_commit ON walls(commit_id);
 )sql",
+    // 3 -> 4: the vehicles table gets the columns `strata vehicles` reports. No version wrote
+    // vehicle rows before, so it is replaced.
+    R"sql(
+DROP TABLE vehicles;
+CREATE TABLE vehicles (
+  id             INTEGER PRIMARY KEY AUTOINCREMENT,
+  commit_id      INTEGER NOT NULL REFERENCES commits(id),
+  vehicle_id     INTEGER NOT NULL,
+  center_x REAL NOT NULL, center_y REAL NOT NULL, center_z REAL NOT NULL,
+  length_m       REAL NOT NULL,
+  width_m        REAL NOT NULL,
+  height_m       REAL NOT NULL,
+  yaw_deg        REAL NOT NULL,
+  source         TEXT NOT NULL CHECK (source IN ('label', 'geometric')),
+  voxels         INTEGER NOT NULL,
+  cleared_voxels INTEGER NOT NULL,
+  refilled_cells INTEGER NOT NULL,
+  refused_cells  INTEGER NOT NULL
+);
+CREATE INDEX vehicles_by_commit ON vehicles(commit_id);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == MapStore::kFormatVersion, "one migration per format version");

@@ -1,12 +1,14 @@
 // Analysis products in the store: grids split by tile and written as new tile versions, with the
 // catalog rows of the analysis, in one commit.
 #include <algorithm>
+#include <map>
 #include <set>
 #include <stdexcept>
 
 #include "store/Catalog.hpp"
 #include "store/MapStoreImpl.hpp"
 #include "store/TileFile.hpp"
+#include "store/TileSplit.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::store {
@@ -40,8 +42,50 @@ void InsertWalls(const detail::Database& db, int64_t commit, const std::vector<W
 
 }  // namespace
 
-int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtrVec& products,
-                                 const std::vector<WallRecord>& walls) {
+namespace {
+
+void InsertVehicles(const detail::Database& db, int64_t commit,
+                    const std::vector<VehicleRecord>& vehicles) {
+    for (const VehicleRecord& v : vehicles) {
+        detail::Statement q(db,
+                            "INSERT INTO vehicles(commit_id, vehicle_id, center_x, center_y, "
+                            "center_z, length_m, width_m, height_m, yaw_deg, source, voxels, "
+                            "cleared_voxels, refilled_cells, refused_cells) "
+                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        q.Bind(1, commit).Bind(2, static_cast<int64_t>(v.vehicle_id));
+        for (int k = 0; k < 3; ++k) q.Bind(3 + k, v.center[k]);
+        for (int k = 0; k < 3; ++k) q.Bind(6 + k, v.size[k]);
+        q.Bind(9, v.yaw_deg)
+            .Bind(10, v.source)
+            .Bind(11, static_cast<int64_t>(v.voxels))
+            .Bind(12, static_cast<int64_t>(v.cleared_voxels))
+            .Bind(13, static_cast<int64_t>(v.refilled_cells))
+            .Bind(14, static_cast<int64_t>(v.refused_cells))
+            .Run();
+    }
+}
+
+// Tiles holding a leaf of any of the grids.
+std::set<TileKey> TilesOf(const openvdb::GridPtrVec& grids, const MapSettings& settings) {
+    std::set<TileKey> keys;
+    for (const auto& g : grids) {
+        g->apply<openvdb::GridTypes>([&](const auto& typed) {
+            for (auto leaf = typed.tree().cbeginLeaf(); leaf; ++leaf) {
+                keys.insert(settings.TileOf(leaf->origin()));
+            }
+        });
+    }
+    return keys;
+}
+
+}  // namespace
+
+// One analysis commit: products (and, for an edit, the fused grids of the tiles they touch)
+// written as new tile versions first, then the catalog rows in one transaction; the new files
+// are removed again when anything fails.
+int64_t MapStore::CommitAnalysis(const std::string& kind, const openvdb::GridPtrVec& products,
+                                 core::VoxelMap* edited, const std::vector<WallRecord>& walls,
+                                 const std::vector<VehicleRecord>& vehicles) {
     impl_->RequireWriter("storing analysis products");
     if (kind != "walls" && kind != "vehicles") {
         throw std::invalid_argument("unknown kind of analysis commit '" + kind + "'");
@@ -58,11 +102,25 @@ int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtr
     }
     const Snapshot latest = Latest();
     const auto last = detail::ReadLastVersions(*impl.db);
+    std::map<TileKey, core::VoxelMap> fused;
+    if (edited != nullptr) {
+        const std::set<TileKey> keys = TilesOf(products, impl.settings);
+        for (const auto& g : edited->Grids()) {
+            g->apply<openvdb::GridTypes>([](auto& typed) { typed.tree().voxelizeActiveTiles(); });
+        }
+        fused = detail::StealMapTiles(*edited, impl.settings, &keys);
+    }
     std::vector<TileVersion> written;
     std::set<fs::path> dirs;
     try {
+        std::map<TileKey, Tile> tiles;
         for (const TileVersion& current : latest.tiles) {
-            Tile tile = ReadTile(current);
+            if (edited != nullptr || !names.empty()) tiles[current.key] = ReadTile(current);
+        }
+        for (auto& [key, map] : fused) {
+            if (!tiles.count(key)) tiles[key].key = key;  // refill reaching a tile of no data
+        }
+        for (auto& [key, tile] : tiles) {
             const size_t before = tile.products.size();
             tile.products.erase(std::remove_if(tile.products.begin(), tile.products.end(),
                                                [&](const openvdb::GridBase::Ptr& g) {
@@ -70,7 +128,11 @@ int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtr
                                                }),
                                 tile.products.end());
             bool changed = tile.products.size() != before;
-            const openvdb::CoordBBox bounds = impl.settings.TileBounds(tile.key);
+            if (auto f = fused.find(key); f != fused.end()) {
+                tile.fused = std::move(f->second);
+                changed = true;
+            }
+            const openvdb::CoordBBox bounds = impl.settings.TileBounds(key);
             for (const auto& g : products) {
                 openvdb::GridBase::Ptr piece = g->deepCopyGrid();
                 piece->clip(bounds);
@@ -80,15 +142,16 @@ int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtr
             }
             if (!changed) continue;
             TileVersion v;
-            v.key = tile.key;
-            v.version = last.at(tile.key) + 1;
+            v.key = key;
+            const auto l = last.find(key);
+            v.version = (l == last.end() ? 0 : l->second) + 1;
             const detail::EncodedTile encoded = detail::EncodeTile(tile);
-            v.file = impl.TileFile(tile.key, v.version);
+            v.file = impl.TileFile(key, v.version);
             detail::WriteTileFile(impl.dir / v.file, encoded.bytes);
             written.push_back(v);
             written.back().bytes = encoded.bytes.size();
             written.back().checksum = encoded.checksum;
-            dirs.insert(impl.TileDir(tile.key));
+            dirs.insert(impl.TileDir(key));
         }
         for (const fs::path& d : dirs) detail::SyncDirectory(d);
         Transaction tx(*impl.db, Transaction::Kind::kWrite);
@@ -98,6 +161,7 @@ int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtr
             detail::InsertTileVersion(*impl.db, v);
         }
         InsertWalls(*impl.db, commit, walls);
+        InsertVehicles(*impl.db, commit, vehicles);
         tx.Commit();
         return commit;
     } catch (...) {
@@ -108,6 +172,47 @@ int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtr
         }
         throw;
     }
+}
+
+int64_t MapStore::CommitProducts(const std::string& kind, const openvdb::GridPtrVec& products,
+                                 const std::vector<WallRecord>& walls) {
+    return CommitAnalysis(kind, products, nullptr, walls, {});
+}
+
+int64_t MapStore::CommitEdit(const std::string& kind, core::VoxelMap& edited,
+                             const openvdb::GridPtrVec& products,
+                             const std::vector<VehicleRecord>& vehicles) {
+    if (edited.voxel_size != impl_->settings.voxel_size_m) {
+        throw std::invalid_argument("the edited map's voxel size differs from the store's");
+    }
+    return CommitAnalysis(kind, products, &edited, {}, vehicles);
+}
+
+std::vector<VehicleRecord> MapStore::Vehicles() const {
+    const detail::Database& db = *impl_->db;
+    std::vector<VehicleRecord> out;
+    if (detail::CatalogVersion(db) < 4) return out;  // older read-only map: no vehicles stored
+    detail::Statement q(db,
+                        "SELECT commit_id, vehicle_id, center_x, center_y, center_z, length_m, "
+                        "width_m, height_m, yaw_deg, source, voxels, cleared_voxels, "
+                        "refilled_cells, refused_cells FROM vehicles "
+                        "WHERE commit_id = (SELECT MAX(id) FROM commits WHERE kind = 'vehicles') "
+                        "ORDER BY vehicle_id");
+    while (q.Step()) {
+        VehicleRecord v;
+        v.commit = q.Int(0);
+        v.vehicle_id = static_cast<int>(q.Int(1));
+        for (int k = 0; k < 3; ++k) v.center[k] = q.Real(2 + k);
+        for (int k = 0; k < 3; ++k) v.size[k] = q.Real(5 + k);
+        v.yaw_deg = q.Real(8);
+        v.source = q.Text(9);
+        v.voxels = static_cast<size_t>(q.Int(10));
+        v.cleared_voxels = static_cast<size_t>(q.Int(11));
+        v.refilled_cells = static_cast<size_t>(q.Int(12));
+        v.refused_cells = static_cast<size_t>(q.Int(13));
+        out.push_back(v);
+    }
+    return out;
 }
 
 std::vector<WallRecord> MapStore::Walls() const {

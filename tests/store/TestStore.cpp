@@ -562,7 +562,53 @@ TEST(Store, AFailedProductCommitLeavesTheMapAsItWas) {
     EXPECT_THROW((void)reader.CommitProducts("walls", {}), std::logic_error);
 }
 
-TEST(Store, MigratesAFormat2CatalogToFormat3) {
+TEST(Store, AnEditOfTheFusedMapIsOneCommitAndTheSessionsStayAsScanned) {
+    const fs::path dir = Temp("edit");
+    MapStore map = NewMap(dir);
+    (void)Write(map, Session(1, {0, 0, 0}));
+    const auto before = map.Latest();
+    const VoxelMap original = map.LoadMap(before);
+    // The edit: occupied voxels at z = 0 removed (a vehicle cleared), one new voxel written
+    // past the edge of the scanned room (a refill reaching a tile with no data).
+    VoxelMap edited = original.DeepCopy();
+    auto cleared = openvdb::Int32Grid::create(0);
+    cleared->setName("vehicle_cleared");
+    cleared->setTransform(VoxelMap::MakeTransform(kVoxel));
+    for (auto it = original.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.0f || it.getCoord().z() != 0) continue;
+        edited.occupancy->tree().setValueOff(it.getCoord(), 0.0f);
+        cleared->tree().setValueOn(it.getCoord(), 7);
+    }
+    const openvdb::Coord far(500, 500, 0);
+    edited.occupancy->tree().setValueOn(far, 0.85f);
+    cleared->tree().setValueOn(far, 8);
+    ASSERT_GT(cleared->activeVoxelCount(), 100u);
+    const VoxelMap expected = edited.DeepCopy();
+    strata::store::VehicleRecord car;
+    car.vehicle_id = 7;
+    car.source = "geometric";
+    car.size = {4.5, 1.8, 1.5};
+    car.cleared_voxels = cleared->activeVoxelCount();
+    const int64_t commit = map.CommitEdit("vehicles", edited, {cleared}, {car});
+    EXPECT_GT(commit, before.commit);
+    ExpectSameMap(map.LoadMap(map.Latest()), expected);
+    ExpectSameMap(map.LoadMap(map.AsOf(1)), original);  // the map as scanned is still there
+    ASSERT_EQ(map.Vehicles().size(), 1u);
+    EXPECT_EQ(map.Vehicles()[0].vehicle_id, 7);
+    EXPECT_EQ(map.Vehicles()[0].source, "geometric");
+    EXPECT_EQ(map.Vehicles()[0].size.x(), 4.5);
+    EXPECT_EQ(ProductVoxels(map, "vehicle_cleared"), cleared->activeVoxelCount());
+    EXPECT_TRUE(map.Check().ok());
+    // A wrong voxel size is refused before anything is written.
+    VoxelMap coarse = VoxelMap::Create(2 * kVoxel);
+    EXPECT_THROW((void)map.CommitEdit("vehicles", coarse, {}, {}), std::invalid_argument);
+    EXPECT_EQ(map.Latest().commit, commit);
+    // Later sessions integrate on top of the edited map.
+    EXPECT_EQ(Write(map, Session(5, {1, 0, 0})).id, 2);
+    EXPECT_TRUE(map.Check().ok());
+}
+
+TEST(Store, MigratesAFormat2CatalogToTheCurrentFormat) {
     const fs::path dir = Temp("migrate");
     {
         MapStore map = NewMap(dir);
@@ -600,6 +646,7 @@ UPDATE settings SET value = '2' WHERE key = 'format_version';
     const int64_t commit = map.CommitProducts("walls", {}, {strata::store::WallRecord{}});
     EXPECT_EQ(map.Walls().size(), 1u);
     EXPECT_GT(commit, map.Latest().sessions[0].commit);
+    EXPECT_TRUE(map.Vehicles().empty());  // format 4's vehicles table, empty
     EXPECT_EQ(Write(map, Session(5, {1, 0, 0})).id, 2);
 }
 

@@ -183,4 +183,22 @@ inline fs::path Temp(const std::string& name) {
     return p;
 }
 
+/// A scratch path unique to this process (CTest runs the tests of one binary in parallel
+/// processes), removed when the process exits. "name.ext" becomes "strata_cli_name_PID.ext".
+inline fs::path Scratch(const std::string& name) {
+    struct Registry {
+        std::vector<fs::path> paths;
+        ~Registry() {
+            std::error_code ignored;
+            for (const auto& p : paths) fs::remove_all(p, ignored);
+        }
+    };
+    static Registry registry;
+    // The process id goes before the extension, which some commands read ("map.ply").
+    const size_t dot = name.rfind('.');
+    const std::string stem = name.substr(0, dot), extension = dot == std::string::npos ? "" : name.substr(dot);
+    registry.paths.push_back(Temp(stem + "_" + std::to_string(::getpid()) + extension));
+    return registry.paths.back();
+}
+
 }  // namespace strata::tools::test

@@ -22,22 +22,6 @@ constexpr double kSlantTolDeg = 0.5;
 // Walls share few voxels (corners).
 constexpr double kMinDistinctInliers = 0.99;
 
-// Scratch names are per process: CTest runs each test of this binary in its own process, in
-// parallel.
-// Each is removed when the process exits (a simulated street map is ~10 MB).
-fs::path Scratch(const std::string& name) {
-    struct Registry {
-        std::vector<fs::path> paths;
-        ~Registry() {
-            std::error_code ignored;
-            for (const auto& p : paths) fs::remove_all(p, ignored);
-        }
-    };
-    static Registry registry;
-    registry.paths.push_back(Temp(name + "_" + std::to_string(::getpid())));
-    return registry.paths.back();
-}
-
 // One map per test process (simulating and integrating takes a few seconds).
 const fs::path& StreetMap() {
     static const fs::path map = [] {

@@ -45,12 +45,7 @@ const ParkingCase& Parking() {
 
 VehicleScore CleanAndScore(const core::VoxelMap& input, const VehicleConfig& config,
                            const char* name) {
-    core::VoxelMap map = input;
-    map.occupancy = openvdb::deepCopyTypedGrid<openvdb::FloatGrid>(input.occupancy);
-    map.label = openvdb::deepCopyTypedGrid<openvdb::Int32Grid>(input.label);
-    map.label_weight = openvdb::deepCopyTypedGrid<openvdb::FloatGrid>(input.label_weight);
-    map.hits = openvdb::deepCopyTypedGrid<openvdb::Int32Grid>(input.hits);
-    map.point_mean = openvdb::deepCopyTypedGrid<openvdb::Vec3SGrid>(input.point_mean);
+    core::VoxelMap map = input.DeepCopy();
     const VehicleResult result = ClearVehicles(map, Parking().origins, config);
     const VehicleScore s = testing::ScoreVehicles(Parking(), map, result);
     std::printf("| %s | %zu / %zu | %zu | %.2f | %zu | %.4f | %.4f | %.4f | %.1f | %.1f | %.1f |\n",

@@ -1,7 +1,10 @@
 #include "MapAccess.hpp"
 
 #include <cstdlib>
+#include <fstream>
 #include <stdexcept>
+
+#include "strata/io/VdbExport.hpp"
 
 namespace strata::tools {
 
@@ -25,6 +28,21 @@ store::MapStore OpenMap(const fs::path& dir, store::MapStore::Access access) {
 
 store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of) {
     return as_of.empty() ? map.Latest() : map.AsOf(map.FindSession(as_of));
+}
+
+void WriteTextFile(const std::string& path, const std::string& text) {
+    const std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.flush();
+        if (!out) throw std::runtime_error(path + ": cannot write");
+    }
+    fs::rename(tmp, path);
+}
+
+void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path) {
+    io::WriteGrids(openvdb::GridCPtrVec(grids.begin(), grids.end()), {}, path);
 }
 
 }  // namespace strata::tools

@@ -7,7 +7,6 @@
 #include "Commands.hpp"
 #include "MapAccess.hpp"
 #include "strata/columns/ColumnPicture.hpp"
-#include "strata/io/VdbExport.hpp"
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::tools {
@@ -27,21 +26,6 @@ struct WallsArgs {
     std::string columns_vdb;
     bool no_save = false;
 };
-
-void WriteText(const std::string& path, const std::string& text) {
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.flush();
-        if (!out) throw std::runtime_error(path + ": cannot write");
-    }
-    std::filesystem::rename(tmp, path);
-}
-
-void WriteVdb(const openvdb::GridPtrVec& grids, const std::string& path) {
-    io::WriteGrids(openvdb::GridCPtrVec(grids.begin(), grids.end()), {}, path);
-}
 
 store::WallRecord Record(const walls::Wall& w) {
     store::WallRecord r;
@@ -98,17 +82,17 @@ void Run(const WallsArgs& args) {
 
     if (!args.columns_csv.empty() || !args.columns_png.empty() || !args.columns_vdb.empty()) {
         const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(voxels);
-        if (!args.columns_csv.empty()) WriteText(args.columns_csv, cols.ToCsv(voxels.voxel_size));
+        if (!args.columns_csv.empty()) WriteTextFile(args.columns_csv, cols.ToCsv(voxels.voxel_size));
         if (!args.columns_png.empty()) {
             columns::WriteColumnPng(cols, voxels.voxel_size, args.columns_png);
         }
         if (!args.columns_vdb.empty()) {
-            WriteVdb(cols.ToGrids(voxels.voxel_size), args.columns_vdb);
+            WriteGridsFile(cols.ToGrids(voxels.voxel_size), args.columns_vdb);
         }
     }
-    if (!args.csv.empty()) WriteText(args.csv, walls::WallsCsv(result));
+    if (!args.csv.empty()) WriteTextFile(args.csv, walls::WallsCsv(result));
     if (!args.png.empty()) walls::WriteWallsPng(voxels, result, args.png);
-    if (!args.vdb.empty()) WriteVdb(walls::WallGrids(result), args.vdb);
+    if (!args.vdb.empty()) WriteGridsFile(walls::WallGrids(result), args.vdb);
     if (args.json) {
         std::cout << walls::WallsJson(result, args.config, voxels.origin);
     } else {

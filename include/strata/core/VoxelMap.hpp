@@ -37,6 +37,8 @@ struct VoxelMap {
     /// @brief An empty map; throws std::invalid_argument unless 0 < voxel_size_m.
     [[nodiscard]] static VoxelMap Create(double voxel_size_m,
                                          const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
+    /// @brief A copy that shares no tree with this map.
+    [[nodiscard]] VoxelMap DeepCopy() const;
     /// @brief The transform every grid of a map with this voxel size uses.
     [[nodiscard]] static openvdb::math::Transform::Ptr MakeTransform(double voxel_size_m);
     /// @brief All grids, named and with metadata, ready to write to a file.

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <optional>
 
 #include "strata/core/Labels.hpp"
 #include "strata/core/VoxelMap.hpp"
@@ -18,6 +19,8 @@ struct TopDownOptions {
     bool draw_scale_bar = true;           ///< labelled scale bar in the bottom-left corner
     core::Rgb unknown_color{16, 16, 16};  ///< columns with no observed voxel
     core::Rgb free_color{64, 64, 64};     ///< observed columns without an occupied voxel
+    std::optional<double> max_z_m;        ///< voxels above this map-frame z are left out
+                                          ///< (a garage's ceiling); unset: none
 };
 
 /// @brief A rendered top-down picture and where it lies: pixel (0, 0) is the top-left (north-west,

@@ -148,6 +148,20 @@ struct WallRecord {
     size_t inliers = 0;
 };
 
+/// @brief One vehicle as the catalog keeps it (`strata vehicles`; docs/vehicles.md). Map frame.
+struct VehicleRecord {
+    int64_t commit = 0;  ///< the commit that stored it (set by the store)
+    int vehicle_id = 0;  ///< id in that commit's `vehicle_cleared` grid
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< box centre
+    Eigen::Vector3d size = Eigen::Vector3d::Zero();    ///< length, width, height
+    double yaw_deg = 0.0;
+    std::string source;  ///< "label" or "geometric"
+    size_t voxels = 0;
+    size_t cleared_voxels = 0;
+    size_t refilled_cells = 0;
+    size_t refused_cells = 0;
+};
+
 struct GcReport {
     std::vector<std::string> removed;
     uint64_t bytes = 0;
@@ -168,7 +182,7 @@ public:
     enum class Access { kRead, kWrite };
 
     /// The newest catalog format this build reads and writes.
-    static constexpr int kFormatVersion = 3;
+    static constexpr int kFormatVersion = 4;
 
     /// True when `dir` holds a catalog.
     [[nodiscard]] static bool IsMap(const std::filesystem::path& dir);
@@ -227,6 +241,16 @@ public:
                            const std::vector<WallRecord>& walls = {});
     /// The walls of the newest commit that stored walls (empty when none did).
     [[nodiscard]] std::vector<WallRecord> Walls() const;
+    /// Stores an edit of the fused map in one commit of kind `kind` ("vehicles"): every tile
+    /// holding a voxel of a `products` grid gets `edited`'s fused grids (its leaves are moved
+    /// out of `edited`, which is left partly empty) and the products, as in CommitProducts;
+    /// `vehicles` become the catalog's vehicle rows of this commit. The session layers are
+    /// untouched, so `--as-of` and change queries still see what was scanned. Writer only.
+    int64_t CommitEdit(const std::string& kind, core::VoxelMap& edited,
+                       const openvdb::GridPtrVec& products,
+                       const std::vector<VehicleRecord>& vehicles);
+    /// The vehicles of the newest commit that stored vehicles (empty when none did).
+    [[nodiscard]] std::vector<VehicleRecord> Vehicles() const;
 
     /// Keeps a change set in the catalog; returns its id. Writer only.
     int64_t SaveChangeSet(const ChangeSetRecord& record);
@@ -240,6 +264,9 @@ public:
 
 private:
     explicit MapStore(std::unique_ptr<Impl> impl);
+    int64_t CommitAnalysis(const std::string& kind, const openvdb::GridPtrVec& products,
+                           core::VoxelMap* edited, const std::vector<WallRecord>& walls,
+                           const std::vector<VehicleRecord>& vehicles);
     /// Opens with the writer lock `lock_fd` already held (or -1 for readers).
     [[nodiscard]] static MapStore OpenWithLock(const std::filesystem::path& dir, Access access,
                                                int lock_fd);

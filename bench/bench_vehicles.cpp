@@ -1,0 +1,138 @@
+// Vehicle pipeline benchmark (issue: parked vehicles cleared, ground refilled): accuracy on the
+// simulated garage (the tables of docs/vehicles.md) and the time of ClearVehicles on real maps.
+//
+//   bench_vehicles [DATA_DIR] [--repeat N]
+//
+// Maps are integrated in memory first (all cores, outside any timing). ClearVehicles runs with
+// all cores (its Embree checks are parallel) and on one core.
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "BenchSupport.hpp"
+#include "ParkingEval.hpp"
+#include "strata/integration/Integrator.hpp"
+#include "strata/vehicles/Vehicles.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using strata::core::VoxelMap;
+using strata::vehicles::VehicleConfig;
+using strata::vehicles::VehicleSource;
+
+double Median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+void PrintScore(const char* voxel, const char* name, const strata::testing::VehicleScore& s,
+                bool boxes) {
+    if (boxes) {
+        std::printf("| %s | %s | %zu / %zu | %zu | %.2f | %zu |", voxel, name, s.matched, s.truth,
+                    s.false_positives, s.mean_iou, s.gap_cells_refilled);
+    } else {
+        std::printf("| %s | %s | | | | |", voxel, name);
+    }
+    std::printf(" %.4f | %.4f | %.4f | %.1f | %.1f | %.1f |\n", s.surface.accuracy_m,
+                s.surface.completeness_m, s.surface.chamfer_l1_m, 100 * s.surface.precision,
+                100 * s.surface.recall, 100 * s.surface.fscore);
+}
+
+void Accuracy() {
+    std::printf(
+        "| voxel m | map | boxes IoU >= 0.7 | false pos. | mean IoU | gap cells filled | "
+        "accuracy m | completeness m | Chamfer-L1 m | precision %% | recall %% | "
+        "F-score @0.1 m %% |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const double voxel : {0.05, 0.1}) {
+        const fs::path work = fs::temp_directory_path() / "strata_bench_vehicles";
+        const strata::testing::ParkingCase c = strata::testing::SimulateParking(
+            fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/parking.json", work, voxel);
+        fs::remove_all(work);
+        const std::string v = voxel == 0.05 ? "0.05" : "0.10";
+        PrintScore(v.c_str(), "as mapped", strata::testing::ScoreVehicles(c, c.labelled, {}),
+                   false);
+        auto run = [&](const VoxelMap& input, VehicleConfig config, const char* name) {
+            VoxelMap map = input.DeepCopy();
+            const auto result = strata::vehicles::ClearVehicles(map, c.origins, config);
+            PrintScore(v.c_str(), name, strata::testing::ScoreVehicles(c, map, result), true);
+        };
+        VehicleConfig labels;
+        labels.source = VehicleSource::kLabel;
+        VehicleConfig clear_only = labels;
+        clear_only.refill = false;
+        VehicleConfig no_rays = labels;
+        no_rays.ray_check = false;
+        VehicleConfig geometric;
+        geometric.source = VehicleSource::kGeometric;
+        run(c.labelled, clear_only, "labels, cleared only");
+        run(c.labelled, no_rays, "labels, refill without ray check");
+        run(c.labelled, labels, "labels, cleared + refill");
+        run(c.unlabelled, geometric, "no labels (geometric), cleared + refill");
+    }
+}
+
+void Speed(const fs::path& data, int repeat) {
+    struct Case {
+        std::string name, folder;
+        double voxel;
+    };
+    const std::vector<Case> cases = {{"BALM, 89 scans", "balm", 0.2},
+                                     {"BALM, 89 scans", "balm", 0.1},
+                                     {"KITTI 00, frames 0-5", "kitti00", 0.1}};
+    std::printf(
+        "\n| map | voxel m | occupied voxels | candidates | vehicles | Embree faces | "
+        "all cores s | one core s (median of %d) |\n|---|---|---|---|---|---|---|---|\n",
+        repeat);
+    for (const Case& c : cases) {
+        const fs::path dir = data / c.folder;
+        if (!fs::exists(dir / "poses.txt")) {
+            std::printf("| %s | %.2f | not found: %s | | | | | |\n", c.name.c_str(), c.voxel,
+                        dir.c_str());
+            continue;
+        }
+        VoxelMap map = VoxelMap::Create(c.voxel);
+        std::vector<Eigen::Vector3d> origins;
+        {
+            strata::integration::Integrator integrator(map, {});
+            for (const auto& scan : strata::bench::LoadKittiScans(dir)) {
+                origins.push_back(scan.T_world_sensor.translation());
+                integrator.Integrate(scan);
+            }
+        }
+        size_t occupied = 0;
+        for (auto it = map.occupancy->cbeginValueOn(); it; ++it) occupied += *it > 0.0f;
+        std::vector<double> all, one;
+        strata::vehicles::VehicleResult result;
+        for (int r = 0; r < repeat; ++r) {
+            VoxelMap work = map.DeepCopy();
+            result = strata::vehicles::ClearVehicles(work, origins);
+            all.push_back(result.seconds);
+            const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+            work = map.DeepCopy();
+            one.push_back(strata::vehicles::ClearVehicles(work, origins).seconds);
+        }
+        std::printf("| %s | %.2f | %zu | %zu | %zu | %zu | %.2f | %.2f |\n", c.name.c_str(),
+                    c.voxel, occupied, result.candidates, result.vehicles.size(),
+                    result.occluder_faces, Median(all), Median(one));
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
+        Accuracy();
+        Speed(args.data, args.repeat);
+        return 0;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_vehicles: %s\n", e.what());
+        return 1;
+    }
+}
