@@ -62,6 +62,17 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
     echo
     "$build/bench/bench_walls" "$root/../shared/data"
   fi
+  if [[ -x "$build/bench/bench_vehicles" ]]; then
+    echo
+    echo "## Vehicles (\`bench/bench_vehicles\`)"
+    echo
+    echo "Accuracy of \`vehicles::ClearVehicles\` on the simulated garage (the table of"
+    echo "[vehicles.md](vehicles.md)), then its time on real maps integrated in memory (outside the"
+    echo "timing), with all cores and with TBB limited to one. Target: a BALM-sized map in a few"
+    echo "seconds."
+    echo
+    "$build/bench/bench_vehicles" "$root/../shared/data"
+  fi
   if [[ -x "$build/bench/bench_sim" ]]; then
     echo
     echo "## Simulator (\`bench/bench_sim\`)"
