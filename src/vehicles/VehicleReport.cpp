@@ -24,14 +24,20 @@ struct PixelFrame {
         return {x_offset + int(std::floor(d.x())),
                 picture.image.height() - 1 - int(std::floor(d.y()))};
     }
+    [[nodiscard]] bool Inside(const Eigen::Vector2i& p) const {
+        return p.x() >= x_offset && p.x() < x_offset + picture.image.width() && p.y() >= 0 &&
+               p.y() < picture.image.height();
+    }
 };
 
-void DrawLine(io::RgbImage& image, Eigen::Vector2i a, const Eigen::Vector2i& b, core::Rgb c) {
+// A line clipped to its half of the picture (a box may reach past the mapped area).
+void DrawLine(io::RgbImage& image, const PixelFrame& frame, Eigen::Vector2i a,
+              const Eigen::Vector2i& b, core::Rgb c) {
     const int dx = std::abs(b.x() - a.x()), dy = -std::abs(b.y() - a.y());
     const int sx = a.x() < b.x() ? 1 : -1, sy = a.y() < b.y() ? 1 : -1;
     int err = dx + dy;
     for (;;) {
-        if (image.Contains(a.x(), a.y())) image.Set(a.x(), a.y(), c);
+        if (frame.Inside(a) && image.Contains(a.x(), a.y())) image.Set(a.x(), a.y(), c);
         if (a == b) return;
         const int e2 = 2 * err;
         if (e2 >= dy) err += dy, a.x() += sx;
@@ -43,7 +49,8 @@ void DrawBoxes(io::RgbImage& image, const PixelFrame& frame, const VehicleResult
     for (const Vehicle& v : result.vehicles) {
         const std::vector<Eigen::Vector2d> corners = v.footprint.Corners();
         for (size_t i = 0; i < corners.size(); ++i) {
-            DrawLine(image, frame.Pixel(corners[i]), frame.Pixel(corners[(i + 1) % 4]), kBoxColor);
+            DrawLine(image, frame, frame.Pixel(corners[i]), frame.Pixel(corners[(i + 1) % 4]),
+                     kBoxColor);
         }
     }
 }
@@ -121,7 +128,8 @@ void WriteVehiclesPng(const core::VoxelMap& before, const core::VoxelMap& after,
             const Eigen::Vector3d c = after.VoxelCenter(it.getCoord());
             const Eigen::Vector2i p =
                 right_frame.Pixel(c.head<2>() - Eigen::Vector2d::Constant(0.5 * after.voxel_size));
-            image.FillRect(p.x(), p.y() - px + 1, px, px, kRefilledColor);
+            if (right_frame.Inside(p))
+                image.FillRect(p.x(), p.y() - px + 1, px, px, kRefilledColor);
         }
     }
     DrawBoxes(image, left_frame, result);
