@@ -83,7 +83,7 @@ Eigen::Vector3d Centroid(const std::vector<Match>& matches) {
 // Cauchy weights of scale `robust_scale` from the current residuals. The rotation turns about
 // the matches' centroid. Returns the increment in the map frame.
 Eigen::Isometry3d SolveIncrement(const std::vector<Match>& matches, double robust_scale,
-                                 int iterations) {
+                                 int iterations, bool planar) {
     const Eigen::Vector3d c = Centroid(matches);
     std::vector<detail::PlaneMatch> planes;
     planes.reserve(matches.size());
@@ -95,6 +95,8 @@ Eigen::Isometry3d SolveIncrement(const std::vector<Match>& matches, double robus
     double x[6] = {0, 0, 0, 0, 0, 0};
     ceres::Problem problem;
     problem.AddResidualBlock(detail::PointToPlaneBatchCost::Create(&planes), nullptr, x);
+    // Planar: roll, pitch (angle-axis x, y) and z stay zero.
+    if (planar) problem.SetManifold(x, new ceres::SubsetManifold(6, {0, 1, 5}));
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_QR;
     options.max_num_iterations = iterations;
@@ -115,8 +117,9 @@ Eigen::Isometry3d SolveIncrement(const std::vector<Match>& matches, double robus
 }
 
 // Eigenvalues (ascending) of the point-to-plane normal matrix per match, rotation columns scaled
-// by the radius of gyration so that they compare with the translation ones.
-Eigen::Matrix<double, 6, 1> NormalEigenvalues(const std::vector<Match>& matches) {
+// by the radius of gyration so that they compare with the translation ones. Planar: those of
+// the yaw, x, y block, then zeros.
+Eigen::Matrix<double, 6, 1> NormalEigenvalues(const std::vector<Match>& matches, bool planar) {
     const Eigen::Vector3d c = Centroid(matches);
     double gyration2 = 0.0;
     for (const Match& m : matches) gyration2 += (m.p - c).squaredNorm();
@@ -129,6 +132,12 @@ Eigen::Matrix<double, 6, 1> NormalEigenvalues(const std::vector<Match>& matches)
         H += row * row.transpose();
     }
     H /= static_cast<double>(matches.size());
+    if (planar) {
+        const Eigen::Matrix3d block = H.block<3, 3>(2, 2);
+        Eigen::Matrix<double, 6, 1> ev = Eigen::Matrix<double, 6, 1>::Zero();
+        ev.head<3>() = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvalues();
+        return ev;
+    }
     return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H).eigenvalues();
 }
 
@@ -191,8 +200,9 @@ RegistrationResult RegisterPoints(const Surface& target, const std::vector<Eigen
                                  " m level: the source does not overlap the map near the guess";
                 break;
             }
-            const Eigen::Isometry3d delta = SolveIncrement(
-                matches, config.robust_scale_ratio * level.cell_m, config.solver_iterations);
+            const Eigen::Isometry3d delta =
+                SolveIncrement(matches, config.robust_scale_ratio * level.cell_m,
+                               config.solver_iterations, config.planar);
             T = delta * T;
             ++result.iterations;
             const double step_m = delta.translation().norm();
@@ -223,7 +233,7 @@ RegistrationResult RegisterPoints(const Surface& target, const std::vector<Eigen
             double sum2 = 0.0;
             for (const Match& m : matches) sum2 += std::pow(m.n.dot(m.p - m.q), 2);
             result.rmse_m = std::sqrt(sum2 / static_cast<double>(matches.size()));
-            result.eigenvalues = NormalEigenvalues(matches);
+            result.eigenvalues = NormalEigenvalues(matches, config.planar);
         }
         if (matches.size() < static_cast<size_t>(config.min_correspondences)) {
             result.refusal = "too few correspondences (" + std::to_string(matches.size()) +

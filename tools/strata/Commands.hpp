@@ -15,5 +15,6 @@ void RegisterSession(CLI::App& app);
 void RegisterMaintenance(CLI::App& app);
 void RegisterDiff(CLI::App& app);
 void RegisterWalls(CLI::App& app);
+void RegisterRegister(CLI::App& app);
 
 }  // namespace strata::tools

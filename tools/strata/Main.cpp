@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     strata::tools::RegisterMaintenance(app);
     strata::tools::RegisterDiff(app);
     strata::tools::RegisterWalls(app);
+    strata::tools::RegisterRegister(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     try {

@@ -23,6 +23,7 @@ struct RegistrationResult {
     double time_ms = 0.0;        ///< wall-clock, surface of the source included
     /// Eigenvalues of the normalised normal matrix at the solution (ascending); the smallest is
     /// near zero along a direction the geometry does not constrain (a corridor, a flat floor).
+    /// Planar alignments fill the first three (yaw, x, y) and leave the rest zero.
     Eigen::Matrix<double, 6, 1> eigenvalues = Eigen::Matrix<double, 6, 1>::Zero();
     std::string brief_report;  ///< one line per level
 };

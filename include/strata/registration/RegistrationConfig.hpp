@@ -53,6 +53,9 @@ struct RegistrationConfig {
     double min_eigenvalue = 0.01;
     /// Fewer correspondences than this at any level is a refusal.
     int min_correspondences = 30;
+    /// Solve x, y and yaw only; z, roll and pitch stay as guessed (floor stacking, where the
+    /// vertical offset comes from the floor height).
+    bool planar = false;
 
     /// @brief Throws std::invalid_argument naming the field when a value is out of range.
     void Validate() const;
