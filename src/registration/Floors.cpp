@@ -28,9 +28,12 @@ Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points) {
 // Better: accepted first, then more overlap, then a smaller residual.
 bool Better(const RegistrationResult& a, const RegistrationResult& b) {
     if (a.converged != b.converged) return a.converged;
-    if (std::abs(a.overlap - b.overlap) > 0.02) return a.overlap > b.overlap;
+    if (a.overlap != b.overlap) return a.overlap > b.overlap;
     return a.rmse_m < b.rmse_m;
 }
+
+// How far a start's result turned from the guess of no rotation (degrees).
+double TurnDeg(const RegistrationResult& r) { return std::abs(YawDeg(r.T_map_source)); }
 
 }  // namespace
 
@@ -98,16 +101,30 @@ FloorStackResult StackFloor(const std::vector<Eigen::Vector3d>& reference_map,
         }
     }
     FloorStackResult out;
-    bool have = false;
+    std::vector<RegistrationResult> results;
     for (const Eigen::Isometry3d& start : starts) {
-        RegistrationResult r = RegisterPoints(target, source_band, start, reg);
+        results.push_back(RegisterPoints(target, source_band, start, reg));
         ++out.starts;
-        if (r.converged) ++out.accepted;
-        if (!have || Better(r, out.result)) {
-            out.result = std::move(r);
-            have = true;
+        if (results.back().converged) ++out.accepted;
+    }
+    // Buildings are often symmetric (a 180 degree turn of a rectangular storey fits almost as
+    // well), so among the results as good as the best (overlap within `kOverlapTie`) the one
+    // turned least from the z-bias guess wins: storeys mapped separately are rarely turned round.
+    constexpr double kOverlapTie = 0.05;
+    size_t best = 0;
+    for (size_t i = 1; i < results.size(); ++i) {
+        if (Better(results[i], results[best])) best = i;
+    }
+    size_t chosen = best;
+    for (size_t i = 0; i < results.size(); ++i) {
+        const RegistrationResult& r = results[i];
+        if (r.converged && r.overlap >= results[best].overlap - kOverlapTie &&
+            TurnDeg(r) < TurnDeg(results[chosen])) {
+            chosen = i;
         }
     }
+    out.result = results[chosen];
+    out.candidates = std::move(results);
     // Step 3: the floor's height from the reference and the bias.
     out.result.T_map_source.translation().z() = reference_floor_z_m + config.z_bias_m;
     return out;

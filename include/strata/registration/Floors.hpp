@@ -38,6 +38,7 @@ struct FloorStackResult {
     RegistrationResult result;  ///< T_map_source = T_map_floor
     int starts = 0;
     int accepted = 0;
+    std::vector<RegistrationResult> candidates;  ///< one per start, in start order
 };
 
 /// @brief Aligns a floor mapped on its own (points in its frame, z = 0 at its floor surface) to
