@@ -1,5 +1,9 @@
 #include "strata/registration/MapRegion.hpp"
 
+#include <tbb/parallel_for.h>
+
+#include "strata/registration/Surface.hpp"
+
 namespace strata::registration {
 
 core::VoxelMap LoadMapRegion(const store::MapStore& map, const store::Snapshot& snapshot,
@@ -16,6 +20,22 @@ core::VoxelMap LoadMapRegion(const store::MapStore& map, const store::Snapshot& 
         if (overlaps) in_range.tiles.push_back(tile);
     }
     return map.LoadMap(in_range);
+}
+
+std::vector<Eigen::Vector3d> SessionPoints(const store::MapStore& map,
+                                           const store::Snapshot& snapshot, int64_t session) {
+    std::vector<std::vector<Eigen::Vector3d>> per_tile(snapshot.tiles.size());
+    tbb::parallel_for(size_t{0}, snapshot.tiles.size(), [&](size_t i) {
+        const store::Tile tile = map.ReadTile(snapshot.tiles[i]);
+        for (const store::SessionLayer& layer : tile.layers) {
+            if (layer.session == session && layer.occupied) {
+                per_tile[i] = MaskedPoints(tile.fused, *layer.occupied);
+            }
+        }
+    });
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& v : per_tile) points.insert(points.end(), v.begin(), v.end());
+    return points;
 }
 
 Eigen::AlignedBox3d BoundsOf(const std::vector<Eigen::Vector3d>& points, const Eigen::Isometry3d& T,

@@ -14,6 +14,12 @@ namespace strata::registration {
                                            const store::Snapshot& snapshot,
                                            const Eigen::AlignedBox3d& box);
 
+/// @brief Where session `session` saw occupied voxels (its `session_<id>_occupied` layer), at
+/// the fused point means, map frame. Every tile of `snapshot` is read (in parallel).
+[[nodiscard]] std::vector<Eigen::Vector3d> SessionPoints(const store::MapStore& map,
+                                                         const store::Snapshot& snapshot,
+                                                         int64_t session);
+
 /// @brief The box around `points` moved by `T`, grown by `margin_m` on every side.
 [[nodiscard]] Eigen::AlignedBox3d BoundsOf(const std::vector<Eigen::Vector3d>& points,
                                            const Eigen::Isometry3d& T, double margin_m);
