@@ -178,14 +178,19 @@ RegistrationResult RegisterPoints(const Surface& target, const std::vector<Eigen
     Eigen::Isometry3d T = T_map_source_init;
     std::ostringstream brief;
     bool last_stage_converged = false;
+    // The source thinned once at the finest spacing (range limits applied there), then again
+    // per level from that much smaller set.
+    const auto Spacing = [&](const SurfaceLevel& level) {
+        return std::max(config.min_source_spacing_m, level.cell_m * config.source_spacing_ratio);
+    };
+    const std::vector<Eigen::Vector3d> finest =
+        Downsample(source, Spacing(target.levels.back()), config.min_source_range_m,
+                   config.max_source_range_m);
     std::vector<Eigen::Vector3d> src;
     for (size_t l = 0; l < target.levels.size() && result.refusal.empty(); ++l) {
         const SurfaceLevel& level = target.levels[l];
-        const double spacing =
-            std::max(config.min_source_spacing_m, level.cell_m * config.source_spacing_ratio);
-        src =
-            Thin(Downsample(source, spacing, config.min_source_range_m, config.max_source_range_m),
-                 static_cast<size_t>(config.max_source_points));
+        src = Thin(l + 1 == target.levels.size() ? finest : Downsample(finest, Spacing(level)),
+                   static_cast<size_t>(config.max_source_points));
         const auto level_start = std::chrono::steady_clock::now();
         if (level.points.empty()) continue;  // a coarse level may have no planar cell
         last_stage_converged = false;

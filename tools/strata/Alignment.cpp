@@ -1,7 +1,9 @@
 #include "Alignment.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <iomanip>
+#include <stdexcept>
 
 #include "Progress.hpp"
 #include "strata/registration/MapRegion.hpp"

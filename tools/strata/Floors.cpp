@@ -2,8 +2,11 @@
 // and scans localized in the slice of one storey (docs/registration.md).
 #include "strata/registration/Floors.hpp"
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 
 #include "Alignment.hpp"
 #include "Commands.hpp"
