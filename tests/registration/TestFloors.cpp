@@ -78,7 +78,7 @@ std::vector<Eigen::Vector3d> Moved(const std::vector<Eigen::Vector3d>& points,
     return out;
 }
 
-TEST(Floors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
+TEST(RegistrationFloors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
     const Building& b = SimulatedBuilding();
     ASSERT_EQ(b.floors.size(), 3u);
     const Eigen::Isometry3d T_map_world = b.spec.sessions[0].T_world_session.inverse();
@@ -119,7 +119,7 @@ TEST(Floors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
     }
 }
 
-TEST(Floors, LocalizesEveryScanOfAFloorInItsSlice) {
+TEST(RegistrationFloors, LocalizesEveryScanOfAFloorInItsSlice) {
     const Building& b = SimulatedBuilding();
     ASSERT_EQ(b.floors.size(), 3u);
     const Eigen::Isometry3d T_map_world = b.spec.sessions[0].T_world_session.inverse();
@@ -169,7 +169,7 @@ TEST(Floors, LocalizesEveryScanOfAFloorInItsSlice) {
     ::testing::Test::RecordProperty("localization_ms_per_scan", std::to_string(ms / seq.size()));
 }
 
-TEST(Floors, SliceAndConfigChecks) {
+TEST(RegistrationFloors, SliceAndConfigChecks) {
     FloorSlice slice;
     slice.l1_m = 2.0;
     slice.l2_m = 1.0;

@@ -22,7 +22,7 @@ std::pair<double, double> Error(const Eigen::Isometry3d& estimate, const Eigen::
     return {d.translation().norm(), AngleDeg(d)};
 }
 
-TEST(RegisterPoints, RecoversKnownTransformOnSyntheticStreet) {
+TEST(RegistrationIcp, RecoversKnownTransformOnSyntheticStreet) {
     const RegistrationConfig config;
     const Surface target = Surface::FromPoints(Street(1), config.surface);
     // The source is another sampling of the street, seen from a frame moved by T_map_source.
@@ -39,7 +39,7 @@ TEST(RegisterPoints, RecoversKnownTransformOnSyntheticStreet) {
     EXPECT_GT(r.iterations, 0);
 }
 
-TEST(RegisterPoints, RecoversFromTheUsersGuess) {
+TEST(RegistrationIcp, RecoversFromTheUsersGuess) {
     const RegistrationConfig config;
     const Surface target = Surface::FromPoints(Street(1), config.surface);
     const Eigen::Isometry3d T_map_source = PoseFromXyzYaw(12.0, 3.0, 0.0, 40.0);
@@ -52,7 +52,7 @@ TEST(RegisterPoints, RecoversFromTheUsersGuess) {
     EXPECT_LT(dr, kRotationTolDeg);
 }
 
-TEST(RegisterPoints, RefusesAGuessFarOutsideTheBasin) {
+TEST(RegistrationIcp, RefusesAGuessFarOutsideTheBasin) {
     const RegistrationConfig config;
     const Surface target = Surface::FromPoints(Street(1), config.surface);
     const auto source = Street(2, 0.13);  // truth: identity
@@ -62,7 +62,7 @@ TEST(RegisterPoints, RefusesAGuessFarOutsideTheBasin) {
     EXPECT_FALSE(r.refusal.empty());
 }
 
-TEST(RegisterPoints, RefusesACloudOfAnotherPlace) {
+TEST(RegistrationIcp, RefusesACloudOfAnotherPlace) {
     const RegistrationConfig config;
     const Surface target = Surface::FromPoints(Street(1), config.surface);
     const RegistrationResult r =
@@ -72,7 +72,7 @@ TEST(RegisterPoints, RefusesACloudOfAnotherPlace) {
     EXPECT_FALSE(r.refusal.empty());
 }
 
-TEST(RegisterPoints, RefusesADegenerateCorridor) {
+TEST(RegistrationIcp, RefusesADegenerateCorridor) {
     const RegistrationConfig config;
     const Surface target = Surface::FromPoints(Corridor(1), config.surface);
     const RegistrationResult r =
@@ -83,7 +83,7 @@ TEST(RegisterPoints, RefusesADegenerateCorridor) {
     EXPECT_LT(r.eigenvalues(0), config.min_eigenvalue);
 }
 
-TEST(RegisterPoints, RejectsBadConfigAndEmptyTarget) {
+TEST(RegistrationIcp, RejectsBadConfigAndEmptyTarget) {
     RegistrationConfig config;
     config.surface.level_cells_m = {0.5, 1.0};
     EXPECT_THROW(config.Validate(), std::invalid_argument);
@@ -96,7 +96,7 @@ TEST(RegisterPoints, RejectsBadConfigAndEmptyTarget) {
                  std::invalid_argument);
 }
 
-TEST(Surface, FitsNormalsOfPlanesAndDropsNothingPlanar) {
+TEST(RegistrationSurface, FitsNormalsOfPlanesAndDropsNothingPlanar) {
     const Surface s = Surface::FromPoints(Street(1), SurfaceConfig{});
     ASSERT_FALSE(s.empty());
     const SurfaceLevel& fine = s.levels.back();

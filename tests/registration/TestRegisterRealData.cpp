@@ -64,7 +64,7 @@ void ExpectWithin(const RegistrationResult& r, const Eigen::Isometry3d& truth, d
     ::testing::Test::RecordProperty(what + "_time_ms", std::to_string(r.time_ms));
 }
 
-TEST(RegisterRealData, Kitti00Frame5ToMapOfFrames0To2) {
+TEST(RegistrationRealData, Kitti00Frame5ToMapOfFrames0To2) {
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "kitti00";
     if (!fs::exists(dir / "poses.txt")) GTEST_SKIP() << dir << " not found";
     const io::KittiSequence seq = io::OpenKittiSequence(dir);
@@ -86,7 +86,7 @@ TEST(RegisterRealData, Kitti00Frame5ToMapOfFrames0To2) {
     ExpectWithin(r, optimum.T_map_source, kTranslationTolM, kRotationTolDeg, "from_guess");
 }
 
-TEST(RegisterRealData, BalmSecondSessionMovedByAKnownTransform) {
+TEST(RegistrationRealData, BalmSecondSessionMovedByAKnownTransform) {
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "balm";
     if (!fs::exists(dir / "poses.txt")) GTEST_SKIP() << dir << " not found";
     const io::KittiSequence seq = io::OpenKittiSequence(dir);

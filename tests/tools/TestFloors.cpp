@@ -72,7 +72,7 @@ Eigen::Matrix4d FromJson(const json& T) {
     return m;
 }
 
-TEST(FloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
+TEST(RegistrationFloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
     const Building& b = BuildingMap();
     const fs::path map = Scratch("floors_stack");
     fs::copy(b.map, map, fs::copy_options::recursive);
@@ -114,7 +114,7 @@ TEST(FloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
     EXPECT_LT((T.translation() - truth.translation()).norm(), kLocalizeTolM) << r.out;
 }
 
-TEST(FloorsCli, RefusesUnknownFloorsAndSessions) {
+TEST(RegistrationFloorsCli, RefusesUnknownFloorsAndSessions) {
     const Building& b = BuildingMap();
     Result r = Strata("localize " + b.map.string() + " --floor 4 --scan x.bin");
     EXPECT_NE(r.code, 0);

@@ -94,7 +94,7 @@ Eigen::Matrix4d FromJson(const json& T) {
     return m;
 }
 
-TEST(RegisterCli, FindsASessionRecordedInAMovedFrameWithTheFixedKeys) {
+TEST(RegistrationCli, FindsASessionRecordedInAMovedFrameWithTheFixedKeys) {
     const Street& s = StreetData();
     const Result r = Strata("register " + s.map.string() + " --kitti " + s.moved.string() +
                             " --frames 6:12 --json");
@@ -110,7 +110,7 @@ TEST(RegisterCli, FindsASessionRecordedInAMovedFrameWithTheFixedKeys) {
     EXPECT_LT(dr, kRotationTolDeg) << r.out;
 }
 
-TEST(RegisterCli, RefusesAGuessFarOffAndSaysWhy) {
+TEST(RegistrationCli, RefusesAGuessFarOffAndSaysWhy) {
     const Street& s = StreetData();
     const Result r = Strata("register " + s.map.string() + " --kitti " + s.seq.string() +
                             " --frames 6:12 --init 3,2,0,120");
@@ -118,7 +118,7 @@ TEST(RegisterCli, RefusesAGuessFarOffAndSaysWhy) {
     EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
 }
 
-TEST(RegisterCli, BadInputFailsNamingTheProblem) {
+TEST(RegistrationCli, BadInputFailsNamingTheProblem) {
     const Street& s = StreetData();
     Result r = Strata("register " + s.map.string());
     EXPECT_NE(r.code, 0);
@@ -130,7 +130,7 @@ TEST(RegisterCli, BadInputFailsNamingTheProblem) {
     EXPECT_NE(r.out.find("no_such_map"), std::string::npos) << r.out;
 }
 
-TEST(IntegrateAlignCli, StoresTheTransformAsTheSessionsAlignment) {
+TEST(RegistrationIntegrateAlignCli, StoresTheTransformAsTheSessionsAlignment) {
     const Street& s = StreetData();
     const fs::path map = CopyOfMap("align_ok");
     const Result r = Strata("integrate " + map.string() + " --kitti " + s.moved.string() +
@@ -147,7 +147,7 @@ TEST(IntegrateAlignCli, StoresTheTransformAsTheSessionsAlignment) {
     EXPECT_NE(day2.notes.find("rmse_m"), std::string::npos) << day2.notes;
 }
 
-TEST(IntegrateAlignCli, ARefusedAlignmentCommitsNothing) {
+TEST(RegistrationIntegrateAlignCli, ARefusedAlignmentCommitsNothing) {
     const Street& s = StreetData();
     const fs::path map = CopyOfMap("align_refused");
     const auto before = MapFiles(map);
@@ -160,7 +160,7 @@ TEST(IntegrateAlignCli, ARefusedAlignmentCommitsNothing) {
     EXPECT_EQ(store.Latest().sessions.size(), 1u);
 }
 
-TEST(IntegrateAlignCli, NeedsAnExistingMap) {
+TEST(RegistrationIntegrateAlignCli, NeedsAnExistingMap) {
     const Street& s = StreetData();
     const fs::path map = Scratch("align_new");
     const Result r =
