@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "Alignment.hpp"
 #include "Commands.hpp"
 #include "MapAccess.hpp"
 #include "ScanSource.hpp"
@@ -28,6 +29,8 @@ struct IntegrateArgs {
     double memory_budget_mb = 0.0;
     int threads = 0;
     integration::IntegrationConfig config;
+    bool align = false;
+    AlignArgs align_args;
 };
 
 bool IsLas(const std::string& path) {
@@ -48,6 +51,17 @@ void Integrate(const IntegrateArgs& args, store::MapStore& map, bool existed) {
     options.name = args.name;
     options.source = source.Describe();
     options.memory_budget_bytes = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    if (args.align) {
+        // Align the session to the map before anything is written: a refusal commits nothing.
+        const SourceCloud cloud = ReadSourceCloud(source, false, args.align_args);
+        const MapAlignment a = AlignToMap(map, map.Latest(), cloud,
+                                          InitialGuess(args.align_args), args.align_args);
+        std::cerr << "strata integrate --align: ";
+        PrintAlignment(a, std::cerr);
+        RequireAccepted(a, "--align: the alignment of " + source.Describe());
+        options.alignment = a.result.T_map_source.matrix();
+        options.notes = "alignment " + AlignmentJson(a).dump();
+    }
     // The effective configuration, so every map can be reproduced.
     std::cerr << "strata integrate: " << source.size() << " scans from " << source.Describe()
               << " into " << args.map << (existed ? "" : " (new)") << ", voxel "
@@ -83,6 +97,11 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
     args.config.Validate();
 
     const bool exists = store::MapStore::IsMap(args.map);
+    if (args.align && !exists) {
+        throw std::invalid_argument("--align needs a map to align to; " + args.map +
+                                    " does not exist yet (integrate the first session without "
+                                    "--align)");
+    }
     std::optional<store::MapStore> map;
     if (exists) {
         map.emplace(store::MapStore::Open(args.map, store::MapStore::Access::kWrite));
@@ -127,6 +146,7 @@ void RegisterIntegrate(CLI::App& app) {
         "  strata integrate city.strata --kitti ../shared/data/kitti00 --frames 0:6 --voxel 0.2\n"
         "  strata integrate garage.strata --scans a.pcd b.pcd --poses poses.txt\n"
         "  strata integrate tile.strata --scans autzen.las --points-only --voxel 1.0\n"
+        "  strata integrate city.strata --kitti day2/ --align --init 3,-1,0,10\n"
         "Each run adds one session; the map changes only once every scan is integrated.");
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     cmd->add_option("--kitti", args->kitti, "KITTI/SemanticKITTI sequence folder");
@@ -152,6 +172,10 @@ void RegisterIntegrate(CLI::App& app) {
         [args](int64_t) { args->config.keep_point_means = false; },
         "Do not keep each voxel's mean endpoint (faster, half the memory; wall slants then "
         "fall back to voxel centres)");
+    cmd->add_flag("--align", args->align,
+                  "Align the session to the map first (strata register); refuse and commit "
+                  "nothing when it fails; the transform is kept as the session's alignment");
+    AddAlignOptions(*cmd, args->align_args, false);
     cmd->callback([args, cmd] { Run(*args, *cmd); });
 }
 

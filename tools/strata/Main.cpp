@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
     strata::tools::RegisterDiff(app);
     strata::tools::RegisterWalls(app);
     strata::tools::RegisterVehicles(app);
+    strata::tools::RegisterRegister(app);
+    strata::tools::RegisterFloors(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     try {

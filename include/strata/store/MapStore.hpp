@@ -160,6 +160,13 @@ struct VehicleRecord {
     size_t cleared_voxels = 0;
     size_t refilled_cells = 0;
     size_t refused_cells = 0;
+/// @brief A storey of a building map (`strata stack`): the session that mapped it in its own
+/// frame, where that frame sits in the map, and the height of its floor surface.
+struct FloorRecord {
+    int index = 0;
+    int64_t session = 0;
+    double z_m = 0.0;  ///< floor surface height in the map frame
+    Eigen::Matrix4d T_map_floor = Eigen::Matrix4d::Identity();  ///< session frame -> map frame
 };
 
 struct GcReport {
@@ -256,6 +263,11 @@ public:
     int64_t SaveChangeSet(const ChangeSetRecord& record);
     /// Every saved change set, oldest first (none in catalogs older than format 2).
     [[nodiscard]] std::vector<ChangeSetRecord> ChangeSets() const;
+
+    /// Records (or replaces) a storey of the map. Writer only.
+    void RecordFloor(const FloorRecord& floor);
+    /// The storeys recorded, by index (none before `strata stack`).
+    [[nodiscard]] std::vector<FloorRecord> Floors() const;
 
     /// @cond internal: used by SessionWriter.
     struct Impl;

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <vector>
+
+#include "strata/core/VoxelMap.hpp"
+#include "strata/registration/RegistrationConfig.hpp"
+
+namespace strata::registration {
+
+/// @brief One level of a matching surface: one point per cell of `cell_m` (the mean of the input
+/// points in it) with the unit normal of its neighbourhood. Only planar cells are kept.
+struct SurfaceLevel {
+    double cell_m = 0.0;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Eigen::Vector3d> normals;
+    /// Cell (floor(p / cell_m)) -> index into points; background -1. Read it with one accessor
+    /// per thread.
+    openvdb::Int32Grid::Ptr index;
+};
+
+/// @brief A surface to match against, coarse to fine (levels in SurfaceConfig order). Immutable
+/// once built, so it may be queried from many threads.
+struct Surface {
+    std::vector<SurfaceLevel> levels;
+
+    /// @brief Builds the levels from points (map frame, metres). Empty input gives empty levels.
+    /// Throws std::invalid_argument on an invalid config.
+    [[nodiscard]] static Surface FromPoints(const std::vector<Eigen::Vector3d>& points,
+                                            const SurfaceConfig& config);
+    [[nodiscard]] bool empty() const { return levels.empty() || levels.back().points.empty(); }
+};
+
+/// @brief Where the endpoints of a map's occupied voxels (log-odds > 0) lay: the `point_mean`
+/// of each voxel, its centre where unknown. Only voxels whose centre is inside `bounds` (map
+/// frame) when given. Parallel over leaves; the order is deterministic.
+[[nodiscard]] std::vector<Eigen::Vector3d> OccupiedPoints(
+    const core::VoxelMap& map, const std::optional<Eigen::AlignedBox3d>& bounds = std::nullopt);
+
+/// @brief The same for the voxels active in `mask` (a session's layer), whatever the fused
+/// occupancy says; positions come from `map`'s point means.
+[[nodiscard]] std::vector<Eigen::Vector3d> MaskedPoints(
+    const core::VoxelMap& map, const openvdb::BoolGrid& mask,
+    const std::optional<Eigen::AlignedBox3d>& bounds = std::nullopt);
+
+/// @brief One point per cell of `cell_m` (the first that falls in it, in input order), keeping
+/// only finite points at least `min_range_m` and (when > 0) at most `max_range_m` from the
+/// origin. Deterministic.
+[[nodiscard]] std::vector<Eigen::Vector3d> Downsample(const std::vector<Eigen::Vector3d>& points,
+                                                      double cell_m, double min_range_m = 0.0,
+                                                      double max_range_m = 0.0);
+
+}  // namespace strata::registration

@@ -1,0 +1,115 @@
+// `strata stack` and `strata localize` through the program, on the simulated three-storey
+// building (datasets/scenes/building.json): each storey a session in its own frame.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "CliTestUtil.hpp"
+#include "strata/store/MapStore.hpp"
+
+namespace strata::tools::test {
+namespace {
+
+using nlohmann::json;
+
+// Issue #8 targets for stacking; localization of one scan within the same 0.05 m.
+constexpr double kXyTolM = 0.05;
+constexpr double kYawTolDeg = 0.2;
+constexpr double kMaxZErrorRate = 0.01;
+constexpr double kLocalizeTolM = 0.05;
+// The storeys' frames in building.json: x, y, z, yaw (deg).
+constexpr double kFloorFrames[3][4] = {{0, 0, 0, 0}, {3.0, -2.0, 3.5, 15}, {-4.0, 1.5, 7.0, -30}};
+
+Eigen::Isometry3d Frame(int k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(kFloorFrames[k][3] * M_PI / 180.0, Eigen::Vector3d::UnitZ())
+                     .toRotationMatrix();
+    T.translation() = Eigen::Vector3d(kFloorFrames[k][0], kFloorFrames[k][1], kFloorFrames[k][2]);
+    return T;
+}
+
+struct Building {
+    fs::path seq;
+    fs::path map;
+};
+
+// Simulated and integrated (one session per storey, each in its own frame) once per process.
+const Building& BuildingMap() {
+    static const Building b = [] {
+        Building out{Scratch("floors_seq"), Scratch("floors_map")};
+        const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/building.json";
+        const Result sim = Strata("simulate --scene " + scene + " --out " + out.seq.string() +
+                                  " --no-picture");  // 40 scans: the whole corridor
+        EXPECT_EQ(sim.code, 0) << sim.out;
+        for (int k = 0; k < 3; ++k) {
+            const Result r = Strata("integrate " + out.map.string() + " --voxel 0.1 --kitti " +
+                                    (out.seq / ("session_" + std::to_string(k))).string() +
+                                    " --name floor_" + std::to_string(k));
+            EXPECT_EQ(r.code, 0) << r.out;
+        }
+        return out;
+    }();
+    return b;
+}
+
+Eigen::Matrix4d FromJson(const json& T) {
+    Eigen::Matrix4d m;
+    for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = T.at(static_cast<size_t>(i)).get<double>();
+    return m;
+}
+
+TEST(RegistrationFloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
+    const Building& b = BuildingMap();
+    const fs::path map = Scratch("floors_stack");
+    fs::copy(b.map, map, fs::copy_options::recursive);
+    for (int k = 1; k <= 2; ++k) {
+        const Result r = Strata("stack " + map.string() + " --floor-session floor_" +
+                                std::to_string(k) + " --z-bias 3.5 --json");
+        ASSERT_EQ(r.code, 0) << r.out;
+        const json j = json::parse(r.out.substr(r.out.find('{')));
+        for (const char* key : {"T", "converged", "rmse_m", "overlap", "time_ms"}) {
+            EXPECT_TRUE(j.contains(key)) << key;
+        }
+        EXPECT_EQ(j["floor"].get<int>(), k);
+        const Eigen::Isometry3d T(FromJson(j["T"]));
+        const Eigen::Isometry3d truth = Frame(k);
+        const Eigen::Vector3d dt = T.translation() - truth.translation();
+        const Eigen::Matrix3d dR = truth.linear().transpose() * T.linear();
+        EXPECT_LT(std::abs(dt.x()), kXyTolM) << r.out;
+        EXPECT_LT(std::abs(dt.y()), kXyTolM) << r.out;
+        EXPECT_LT(std::abs(std::atan2(dR(1, 0), dR(0, 0))) * 180 / M_PI, kYawTolDeg) << r.out;
+        EXPECT_LE(std::abs(dt.z()) / truth.translation().z(), kMaxZErrorRate) << r.out;
+    }
+    const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
+    ASSERT_EQ(store.Floors().size(), 3u);
+    EXPECT_NEAR(store.Floors()[2].z_m, 7.0, 7.0 * kMaxZErrorRate);
+
+    // A scan of floor 1 from a guess 0.3 m and 3 deg off its true pose.
+    const fs::path floor1 = b.seq / "session_1";
+    const Eigen::Isometry3d pose = io::ReadPoseFile(floor1 / "poses.txt").at(6).T;
+    const Eigen::Isometry3d truth = Frame(1) * pose;
+    const Eigen::Vector3d g = truth.translation() + Eigen::Vector3d(0.2, -0.2, 0.05);
+    const double yaw = std::atan2(truth.linear()(1, 0), truth.linear()(0, 0)) * 180 / M_PI + 3.0;
+    const Result r = Strata("localize " + map.string() + " --floor 1 --json --scan " +
+                            (floor1 / "velodyne" / "000006.bin").string() + " --init " +
+                            std::to_string(g.x()) + "," + std::to_string(g.y()) + "," +
+                            std::to_string(g.z()) + "," + std::to_string(yaw));
+    ASSERT_EQ(r.code, 0) << r.out;
+    const json j = json::parse(r.out.substr(r.out.find('{')));
+    const Eigen::Isometry3d T(FromJson(j["T"]));
+    EXPECT_LT((T.translation() - truth.translation()).norm(), kLocalizeTolM) << r.out;
+}
+
+TEST(RegistrationFloorsCli, RefusesUnknownFloorsAndSessions) {
+    const Building& b = BuildingMap();
+    Result r = Strata("localize " + b.map.string() + " --floor 4 --scan x.bin");
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find("--floor 4"), std::string::npos) << r.out;
+    r = Strata("stack " + b.map.string() + " --floor-session no_such_session");
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find("no_such_session"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace strata::tools::test

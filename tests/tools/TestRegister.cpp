@@ -1,0 +1,161 @@
+// `strata register` and `strata integrate --align` through the program, on the simulated
+// street: the second half of a drive, recorded in a frame moved by a known transform, is found;
+// a guess far off is refused and leaves the map as it was.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "CliTestUtil.hpp"
+#include "strata/store/MapStore.hpp"
+
+namespace strata::tools::test {
+namespace {
+
+using nlohmann::json;
+
+// Simulated scans (2 cm range noise), half a street of overlap.
+constexpr double kTranslationTolM = 0.05;
+constexpr double kRotationTolDeg = 0.2;
+// The frame the second session was recorded in: x, y, z, yaw.
+constexpr double kMoveX = 1.2, kMoveY = -0.8, kMoveZ = 0.2, kMoveYawDeg = 6.0;
+
+Eigen::Isometry3d Move() {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() =
+        Eigen::AngleAxisd(kMoveYawDeg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(kMoveX, kMoveY, kMoveZ);
+    return T;
+}
+
+struct Street {
+    fs::path seq;    // the simulated drive, world frame
+    fs::path moved;  // the same scans, poses in a frame moved by Move()
+    fs::path map;    // frames 0-5 integrated
+};
+
+const Street& StreetData() {
+    static const Street street = [] {
+        Street s;
+        s.seq = Scratch("register_seq");
+        s.moved = Scratch("register_moved");
+        s.map = Scratch("register_map");
+        const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
+        const Result sim = Strata("simulate --scene " + scene + " --out " + s.seq.string() +
+                                  " --max-scans 12 --no-picture");
+        EXPECT_EQ(sim.code, 0) << sim.out;
+        fs::create_directories(s.moved);
+        fs::create_directory_symlink(fs::absolute(s.seq / "velodyne"), s.moved / "velodyne");
+        for (const char* f : {"calib.txt", "times.txt"}) {
+            if (fs::exists(s.seq / f)) fs::copy_file(s.seq / f, s.moved / f);
+        }
+        std::vector<Eigen::Isometry3d> poses;
+        for (const auto& p : io::ReadPoseFile(s.seq / "poses.txt")) {
+            poses.push_back(Move().inverse() * p.T);
+        }
+        io::WriteKittiPoses(s.moved / "poses.txt", poses);
+        const Result integrate =
+            Strata("integrate " + s.map.string() + " --kitti " + s.seq.string() + " --frames 0:6");
+        EXPECT_EQ(integrate.code, 0) << integrate.out;
+        return s;
+    }();
+    return street;
+}
+
+fs::path CopyOfMap(const std::string& name) {
+    const fs::path dir = Scratch(name);
+    fs::copy(StreetData().map, dir, fs::copy_options::recursive);
+    return dir;
+}
+
+// Translation (m) and rotation (deg) between two transforms.
+std::pair<double, double> Difference(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+    const Eigen::Matrix4d d = a.inverse() * b;
+    return {d.block<3, 1>(0, 3).norm(),
+            Eigen::AngleAxisd(Eigen::Matrix3d(d.block<3, 3>(0, 0))).angle() * 180.0 / M_PI};
+}
+
+Eigen::Matrix4d FromJson(const json& T) {
+    Eigen::Matrix4d m;
+    for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = T.at(static_cast<size_t>(i)).get<double>();
+    return m;
+}
+
+TEST(RegistrationCli, FindsASessionRecordedInAMovedFrameWithTheFixedKeys) {
+    const Street& s = StreetData();
+    const Result r = Strata("register " + s.map.string() + " --kitti " + s.moved.string() +
+                            " --frames 6:12 --json");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const json j = json::parse(r.out.substr(r.out.find('{')));
+    for (const char* key : {"T", "converged", "rmse_m", "overlap", "time_ms"}) {
+        EXPECT_TRUE(j.contains(key)) << key;
+    }
+    ASSERT_EQ(j["T"].size(), 16u);
+    EXPECT_TRUE(j["converged"].get<bool>());
+    const auto [dt, dr] = Difference(FromJson(j["T"]), Move().matrix());
+    EXPECT_LT(dt, kTranslationTolM) << r.out;
+    EXPECT_LT(dr, kRotationTolDeg) << r.out;
+}
+
+TEST(RegistrationCli, RefusesAGuessFarOffAndSaysWhy) {
+    const Street& s = StreetData();
+    const Result r = Strata("register " + s.map.string() + " --kitti " + s.seq.string() +
+                            " --frames 6:12 --init 3,2,0,120");
+    EXPECT_NE(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
+}
+
+TEST(RegistrationCli, BadInputFailsNamingTheProblem) {
+    const Street& s = StreetData();
+    Result r = Strata("register " + s.map.string());
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find("--kitti"), std::string::npos) << r.out;
+    r = Strata("register " + s.map.string() + " --kitti " + s.seq.string() + " --init 1,2,3");
+    EXPECT_NE(r.code, 0) << r.out;
+    r = Strata("register " + Scratch("no_such_map").string() + " --kitti " + s.seq.string());
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find("no_such_map"), std::string::npos) << r.out;
+}
+
+TEST(RegistrationIntegrateAlignCli, StoresTheTransformAsTheSessionsAlignment) {
+    const Street& s = StreetData();
+    const fs::path map = CopyOfMap("align_ok");
+    const Result r = Strata("integrate " + map.string() + " --kitti " + s.moved.string() +
+                            " --frames 6:12 --align --name day2");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
+    const store::Snapshot latest = store.Latest();
+    ASSERT_EQ(latest.sessions.size(), 2u);
+    const store::SessionRecord& day2 = latest.sessions.back();
+    EXPECT_EQ(day2.name, "day2");
+    const auto [dt, dr] = Difference(day2.alignment, Move().matrix());
+    EXPECT_LT(dt, kTranslationTolM);
+    EXPECT_LT(dr, kRotationTolDeg);
+    EXPECT_NE(day2.notes.find("rmse_m"), std::string::npos) << day2.notes;
+}
+
+TEST(RegistrationIntegrateAlignCli, ARefusedAlignmentCommitsNothing) {
+    const Street& s = StreetData();
+    const fs::path map = CopyOfMap("align_refused");
+    const auto before = MapFiles(map);
+    const Result r = Strata("integrate " + map.string() + " --kitti " + s.moved.string() +
+                            " --frames 6:12 --align --init 3,2,0,120");
+    EXPECT_NE(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
+    EXPECT_EQ(MapFiles(map), before);
+    const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
+    EXPECT_EQ(store.Latest().sessions.size(), 1u);
+}
+
+TEST(RegistrationIntegrateAlignCli, NeedsAnExistingMap) {
+    const Street& s = StreetData();
+    const fs::path map = Scratch("align_new");
+    const Result r =
+        Strata("integrate " + map.string() + " --kitti " + s.seq.string() + " --align");
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find("--align"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(map));
+}
+
+}  // namespace
+}  // namespace strata::tools::test

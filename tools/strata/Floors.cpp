@@ -1,0 +1,226 @@
+// strata stack and strata localize: storeys mapped one at a time, stacked on the ones below,
+// and scans localized in the slice of one storey (docs/registration.md).
+#include "strata/registration/Floors.hpp"
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "Alignment.hpp"
+#include "Commands.hpp"
+#include "MapAccess.hpp"
+#include "strata/io/KittiSequence.hpp"
+#include "strata/io/PointCloudReaders.hpp"
+#include "strata/registration/MapRegion.hpp"
+
+namespace strata::tools {
+
+namespace {
+
+namespace reg = registration;
+
+std::vector<Eigen::Vector3d> Moved(std::vector<Eigen::Vector3d> points, const Eigen::Matrix4d& T) {
+    const Eigen::Isometry3d iso(T);
+    for (Eigen::Vector3d& p : points) p = iso * p;
+    return points;
+}
+
+void PrintJsonOrText(const nlohmann::json& j, const MapAlignment& a, bool json, int floor,
+                     double z_m) {
+    if (json) {
+        nlohmann::json out = j;
+        out["floor"] = floor;
+        out["z_m"] = z_m;
+        std::cout << out.dump(2) << "\n";
+    } else {
+        std::cout << "floor " << floor << " (floor surface at z " << z_m << " m)\n";
+        PrintAlignment(a, std::cout);
+    }
+}
+
+struct StackArgs {
+    std::string map;
+    std::string session;
+    double z_bias = 3.5;
+    bool json = false;
+    AlignArgs align;
+    reg::FloorSlice slice;
+};
+
+void RunStack(const StackArgs& args) {
+    store::MapStore map = OpenMap(args.map, store::MapStore::Access::kWrite);
+    const store::Snapshot snapshot = map.Latest();
+    const int64_t session = map.FindSession(args.session);
+    std::vector<store::FloorRecord> floors = map.Floors();
+    for (const store::FloorRecord& f : floors) {
+        if (f.session == session) {
+            throw std::invalid_argument("session " + std::to_string(session) + " is floor " +
+                                        std::to_string(f.index) + " already");
+        }
+    }
+    // No floor yet: the oldest other session is the ground floor, in the map frame.
+    store::FloorRecord base;
+    if (floors.empty()) {
+        for (const store::SessionRecord& s : snapshot.sessions) {
+            if (s.id != session) {
+                base.session = s.id;
+                break;
+            }
+        }
+        if (base.session == 0) {
+            throw std::invalid_argument(args.map + " has no other session to stack session " +
+                                        std::to_string(session) + " on");
+        }
+        floors.push_back(base);
+    }
+    const store::FloorRecord& below = floors.back();
+    reg::FloorStackConfig config;
+    config.z_bias_m = args.z_bias;
+    config.slice = args.slice;
+    config.registration.min_overlap = args.align.config.min_overlap;
+    config.registration.max_rmse_m = args.align.config.max_rmse_m;
+    const std::vector<Eigen::Vector3d> reference =
+        Moved(reg::SessionPoints(map, snapshot, below.session), below.T_map_floor);
+    const std::vector<Eigen::Vector3d> floor = reg::SessionPoints(map, snapshot, session);
+    std::optional<Eigen::Isometry3d> guess;
+    if (!args.align.init.empty()) guess = InitialGuess(args.align);
+    const reg::FloorStackResult r =
+        reg::StackFloor(reference, below.z_m, floor, config, guess ? &*guess : nullptr);
+    MapAlignment a;
+    a.result = r.result;
+    a.map_points = reference.size();
+    a.total_ms = r.result.time_ms;
+    store::FloorRecord record;
+    record.index = below.index + 1;
+    record.session = session;
+    record.T_map_floor = r.result.T_map_source.matrix();
+    record.z_m = r.result.T_map_source.translation().z();
+    nlohmann::json j = AlignmentJson(a);
+    j["starts"] = r.starts;
+    j["session"] = session;
+    j["below"] = below.index;
+    PrintJsonOrText(j, a, args.json, record.index, record.z_m);
+    RequireAccepted(a, "stacking session " + std::to_string(session));
+    if (map.Floors().empty()) map.RecordFloor(base);
+    map.RecordFloor(record);
+}
+
+struct LocalizeArgs {
+    std::string map;
+    std::string scan;
+    int floor = 0;
+    bool json = false;
+    AlignArgs align;
+    reg::FloorSlice slice = [] {
+        reg::FloorSlice s;  // the storey with its floor and ceiling, none of the others
+        s.l1_m = -0.2;
+        s.l2_m = 3.1;
+        return s;
+    }();
+};
+
+core::Scan ReadScan(const std::string& file) {
+    std::string ext = std::filesystem::path(file).extension().string();
+    if (ext == ".bin") {
+        core::Scan scan;
+        scan.points = io::ReadKittiBin(file).points;
+        scan.source = file;
+        return scan;
+    }
+    return io::ReadPointCloud(file, {});
+}
+
+void RunLocalize(const LocalizeArgs& args) {
+    args.slice.Validate();
+    const store::MapStore map = OpenMap(args.map);
+    const std::vector<store::FloorRecord> floors = map.Floors();
+    const auto it = std::find_if(floors.begin(), floors.end(), [&](const store::FloorRecord& f) {
+        return f.index == args.floor;
+    });
+    if (it == floors.end()) {
+        throw std::invalid_argument("--floor " + std::to_string(args.floor) + ": " + args.map +
+                                    " has " + std::to_string(floors.size()) +
+                                    " floors recorded (strata stack records them)");
+    }
+    // The slice of the stacked map: every storey moved into the map frame, then cut.
+    const store::Snapshot snapshot = map.Latest();
+    std::vector<Eigen::Vector3d> slice;
+    const Eigen::AlignedBox3d box = args.slice.Box(it->z_m);
+    for (const store::FloorRecord& f : floors) {
+        for (const Eigen::Vector3d& p :
+             Moved(reg::SessionPoints(map, snapshot, f.session), f.T_map_floor)) {
+            if (box.contains(p)) slice.push_back(p);
+        }
+    }
+    reg::RegistrationConfig config = args.align.config;
+    config.surface.level_cells_m = {1.0, 0.5, 0.25};
+    config.max_source_points = 1500;
+    config.min_source_range_m = args.align.min_range_m;
+    config.max_source_range_m = args.align.max_range_m;
+    const reg::Surface surface = reg::Surface::FromPoints(slice, config.surface);
+    if (surface.empty())
+        throw std::runtime_error("floor " + std::to_string(args.floor) +
+                                 " has no surface in its slice");
+    const core::Scan scan = ReadScan(args.scan);
+    const Eigen::Isometry3d guess =
+        args.align.init.empty() ? Eigen::Isometry3d(it->T_map_floor) : InitialGuess(args.align);
+    MapAlignment a;
+    a.result = reg::RegisterPoints(surface, scan.points, guess, config);
+    a.map_points = slice.size();
+    a.total_ms = a.result.time_ms;
+    PrintJsonOrText(AlignmentJson(a), a, args.json, args.floor, it->z_m);
+    RequireAccepted(a, "localization");
+}
+
+}  // namespace
+
+void RegisterFloors(CLI::App& app) {
+    auto stack = std::make_shared<StackArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "stack", "Stack a floor mapped on its own (a session) on the floors below");
+    cmd->footer(
+        "Example:\n"
+        "  strata stack building.strata --floor-session floor_1 --z-bias 3.5 --json\n"
+        "The first stack makes the oldest other session floor 0. x, y and yaw come from the walls\n"
+        "both floors share (planar ICP over a yaw search, or from --init), z from the floor below\n"
+        "plus --z-bias. The floor's frame and height are recorded in the catalog; the voxels stay\n"
+        "as integrated. Refused alignments record nothing.");
+    cmd->add_option("MAP", stack->map, "Map directory")->required();
+    cmd->add_option("--floor-session", stack->session, "Session (id or name) of the floor")
+        ->required();
+    cmd->add_option("--z-bias", stack->z_bias, "Height of the floor above the one below (m)")
+        ->capture_default_str();
+    cmd->add_option("--l1", stack->slice.l1_m, "Wall band: above the floor surface (m)")
+        ->capture_default_str();
+    cmd->add_option("--l2", stack->slice.l2_m, "Wall band: below this height (m)")
+        ->capture_default_str();
+    cmd->add_flag("--json", stack->json, "Print the result as JSON");
+    stack->align.config.min_overlap = reg::FloorStackConfig::DefaultRegistration().min_overlap;
+    AddAlignOptions(*cmd, stack->align, false);
+    cmd->callback([stack] { RunStack(*stack); });
+
+    auto loc = std::make_shared<LocalizeArgs>();
+    CLI::App* lcmd =
+        app.add_subcommand("localize", "Localize a scan in the slice l1 < z - z_k < l2 of floor K");
+    lcmd->footer(
+        "Example:\n"
+        "  strata localize building.strata --scan scan.pcd --floor 1 --init 12,8,4.7,180\n"
+        "--init is the guess in the map frame (default: the floor's frame). Reports the pose\n"
+        "(T, scan -> map) and the time per scan; exits non-zero when refused.");
+    lcmd->add_option("MAP", loc->map, "Map directory")->required();
+    lcmd->add_option("--scan", loc->scan, "Scan file (PCD, PLY, LAS, text or KITTI .bin)")
+        ->required();
+    lcmd->add_option("--floor", loc->floor, "Floor index K")->required();
+    lcmd->add_option("--l1", loc->slice.l1_m, "Slice: lowest height above the floor (m)")
+        ->capture_default_str();
+    lcmd->add_option("--l2", loc->slice.l2_m, "Slice: highest height above the floor (m)")
+        ->capture_default_str();
+    lcmd->add_flag("--json", loc->json, "Print the result as JSON");
+    loc->align.min_range_m = 0.5;
+    AddAlignOptions(*lcmd, loc->align);
+    lcmd->callback([loc] { RunLocalize(*loc); });
+}
+
+}  // namespace strata::tools
