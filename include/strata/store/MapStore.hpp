@@ -160,6 +160,8 @@ struct VehicleRecord {
     size_t cleared_voxels = 0;
     size_t refilled_cells = 0;
     size_t refused_cells = 0;
+};
+
 /// @brief A storey of a building map (`strata stack`): the session that mapped it in its own
 /// frame, where that frame sits in the map, and the height of its floor surface.
 struct FloorRecord {
