@@ -11,8 +11,8 @@ if(STRATA_BUILD_FUZZ OR STRATA_SANITIZE)
                         "is ${CMAKE_CXX_COMPILER_ID}: configure a fresh build directory with "
                         "-DCMAKE_CXX_COMPILER=clang++ (tools/fuzz.sh and tools/sanitize.sh do)")
   endif()
-  # After the build type's -O2 -g, so these win: -O1 and line tables only compile the
-  # OpenVDB-heavy files about twice as fast, and line tables are all a sanitizer report needs.
+  # After the build type's -O2 -g, so these win: -O1 and line tables only, to compile the
+  # OpenVDB-heavy files faster; line tables are all a sanitizer report needs.
   add_compile_options(-O1 -gline-tables-only)
 endif()
 

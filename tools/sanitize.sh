@@ -16,9 +16,13 @@
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
 # Tests read STRATA_SANITIZER (address or thread, set here) to shrink what is too slow there.
 set -euo pipefail
+shopt -s inherit_errexit  # BuildTsanTbb runs in $(...): stop at its first failure too
 root=$(cd "$(dirname "$0")/.." && pwd)
 mode=${1:-}
-[[ $mode == asan || $mode == tsan ]] || { echo "usage: tools/sanitize.sh asan|tsan [CTEST_ARGS...]" >&2; exit 2; }
+if [[ $mode != asan && $mode != tsan ]]; then
+  echo "usage: tools/sanitize.sh asan|tsan [CTEST_ARGS...]" >&2
+  exit 2
+fi
 shift
 jobs=${STRATA_BUILD_JOBS:-$(nproc)}
 
@@ -32,7 +36,10 @@ tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection)\.|^OctomapAgreement\.
 tsan_tests+='|^Store\.(SessionsEqualInMemory|OneWriterAtATime|ReadersSeeWholeCommits)'
 tsan_tests+='|^StoreFaults\.ReaderProcessesSeeWholeCommits'
 
-command -v clang++ >/dev/null || { echo "sanitize.sh: clang++ not found (tools/setup.sh installs it)" >&2; exit 1; }
+if ! command -v clang++ >/dev/null; then
+  echo "sanitize.sh: clang++ not found (tools/setup.sh installs it)" >&2
+  exit 1
+fi
 launcher=()
 if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
@@ -53,14 +60,20 @@ BuildTsanTbb() {
   rm -rf "$dir/onetbb" "$dir/tbb"
   apt_dir="$dir/onetbb/apt"
   mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$dir/onetbb/src"
-  printf 'deb-src http://deb.debian.org/debian %s main\n' bookworm bookworm-updates \
-    >"$apt_dir/sources.list"
-  echo 'deb-src http://deb.debian.org/debian-security bookworm-security main' >>"$apt_dir/sources.list"
-  local apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources.list" -o Dir::Etc::SourceParts=/dev/null
-                  -o "Dir::State::Lists=$apt_dir/lists" -o "Dir::Cache=$apt_dir/cache")
+  {
+    printf 'deb-src http://deb.debian.org/debian %s main\n' bookworm bookworm-updates
+    echo 'deb-src http://deb.debian.org/debian-security bookworm-security main'
+  } >"$apt_dir/sources.list"
+  local apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources.list"
+                  -o Dir::Etc::SourceParts=/dev/null -o "Dir::State::Lists=$apt_dir/lists"
+                  -o "Dir::Cache=$apt_dir/cache")
   apt-get "${apt_opts[@]}" update >&2
-  (cd "$dir/onetbb/src" && apt-get "${apt_opts[@]}" source --download-only "onetbb=$version" >&2 2>/dev/null \
-     || { echo "sanitize.sh: no source package onetbb=$version" >&2; exit 1; })
+  # apt-get warns that root downloads unsandboxed into a folder _apt cannot write: harmless.
+  if ! (cd "$dir/onetbb/src" &&
+        apt-get "${apt_opts[@]}" source --download-only "onetbb=$version" >/dev/null 2>&1); then
+    echo "sanitize.sh: no Debian source package onetbb=$version to build a TSan libtbb" >&2
+    exit 1
+  fi
   # --no-check: apt-get has verified the files against the signed Sources index; the .dsc's own
   # signature needs the maintainers' keys (debian-keyring), which the machine does not have.
   dpkg-source --no-check -x "$dir"/onetbb/src/onetbb_*.dsc "$dir/onetbb/tree" >/dev/null
@@ -106,9 +119,10 @@ export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$reports/t
 [[ -n ${STRATA_SANITIZE_TARGETS:-} ]] && filter+=(-E _NOT_BUILT)
 test_start=$(date +%s)
 status=0
-ctest --test-dir "$build" --output-on-failure -j "${STRATA_TEST_JOBS:-$(nproc)}" "${filter[@]}" "$@" \
-  || status=$?
-echo "sanitize.sh: $mode tests took $(($(date +%s) - test_start)) s, $(($(date +%s) - start)) s in all"
+ctest --test-dir "$build" --output-on-failure -j "${STRATA_TEST_JOBS:-$(nproc)}" \
+  "${filter[@]}" "$@" || status=$?
+end=$(date +%s)
+echo "sanitize.sh: $mode tests took $((end - test_start)) s, $((end - start)) s in all"
 if compgen -G "$reports/*" >/dev/null; then
   echo "sanitize.sh: sanitizer reports from $(ls "$reports" | wc -l) processes:" >&2
   for f in "$reports"/*; do echo "== $f" >&2; head -60 "$f" >&2; done
