@@ -4,6 +4,7 @@
 # report, a hang (-timeout) or runaway memory (-rss_limit_mb). docs/reliability.md, "Fuzzing".
 # Usage: tools/fuzz.sh [SECONDS_PER_TARGET]   (default 20)
 #   STRATA_FUZZ_TARGETS="pcd ply"  only these targets     STRATA_BUILD_JOBS=2  build parallelism
+#   STRATA_WERROR=1  warnings are errors (CI)
 # Corpora grow in build-fuzz/corpus/<target>/ across runs; crash inputs land in
 # build-fuzz/artifacts/, each target's output in build-fuzz/logs/<target>.log.
 set -euo pipefail
@@ -24,9 +25,12 @@ if command -v ccache >/dev/null; then
   export CCACHE_BASEDIR="$root"
 fi
 start=$(date +%s)
+# Tests and tools are configured (not built) so that tools/sanitize.sh asan, which builds and
+# runs them here, shares every object with this script: keep the two configurations equal.
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_COMPILER=clang++ -DSTRATA_BUILD_FUZZ=ON -DSTRATA_BUILD_TESTS=OFF \
-  -DSTRATA_BUILD_TOOLS=OFF -DSTRATA_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
+  -DCMAKE_CXX_COMPILER=clang++ -DSTRATA_BUILD_FUZZ=ON -DSTRATA_BUILD_TESTS=ON \
+  -DSTRATA_BUILD_TOOLS=ON -DSTRATA_BUILD_BENCH=OFF \
+  -DSTRATA_WARNINGS_AS_ERRORS="${STRATA_WERROR:-0}" "${launcher[@]}" >/dev/null
 cmake --build "$build" -j "${STRATA_BUILD_JOBS:-$(nproc)}" --target fuzz
 echo "fuzz.sh: build took $(($(date +%s) - start)) s"
 

@@ -58,7 +58,12 @@ TEST(ColumnStats, WindowSumsMatchBruteForce) {
     std::vector<Coord> voxels;
     std::vector<int32_t> points;
     for (int i = 0; i < 2000; ++i) {
-        voxels.emplace_back(xy(rng), xy(rng), z(rng));
+        // One draw each, z first: argument order is unspecified and the voxels must not
+        // depend on the compiler (this is gcc's order).
+        const int32_t vz = z(rng);
+        const int32_t vy = xy(rng);
+        const int32_t vx = xy(rng);
+        voxels.emplace_back(vx, vy, vz);
         points.push_back(n(rng));
     }
     const ColumnGrid cols = ColumnGrid::FromVoxels(voxels, points);

@@ -38,7 +38,12 @@ core::Scan RoomScan(uint32_t seed, size_t n) {
     const Eigen::Vector3d centre(0.31, 0.17, 0.05);  // walls off the 0.1 m voxel faces
     std::vector<Eigen::Vector3d> points;
     for (size_t i = 0; i < n; ++i) {
-        Eigen::Vector3d d(u(rng), u(rng), u(rng));
+        // z, y, x, one draw each: argument order is unspecified (gcc right to left, clang left to
+        // right) and the scan must not depend on the compiler; this is the order gcc always used.
+        Eigen::Vector3d d;
+        d.z() = u(rng);
+        d.y() = u(rng);
+        d.x() = u(rng);
         const double t = (half.array() / d.array().abs()).minCoeff();  // hit the box from centre
         points.push_back(centre + d * t);
     }

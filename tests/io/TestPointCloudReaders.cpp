@@ -345,11 +345,15 @@ TEST(PointCloudReaders, ReportEveryTruncationOfBinaryFiles) {
         {"be.ply", MakePly("binary_big_endian")},
         {"v12.las", MakeLas(2, 3, 34)},
         {"v14.las", MakeLas(4, 6, 32)}};
-    for (const auto& [name, bytes] : files) {
+    for (const auto& file : files) {
+        // A plain variable, not a structured binding: clang 14 (the sanitizer builds,
+        // tools/sanitize.sh) cannot capture a binding in the lambda below.
+        const fs::path path = dir / file.first;
+        const std::string& bytes = file.second;
         for (size_t length = 0; length < bytes.size(); ++length) {
-            WriteFile(dir / name, bytes.substr(0, length));
-            SCOPED_TRACE(name + " cut to " + std::to_string(length) + " bytes");
-            ExpectReadError([&] { return ReadPointCloud(dir / name); }, dir / name);
+            WriteFile(path, bytes.substr(0, length));
+            SCOPED_TRACE(file.first + " cut to " + std::to_string(length) + " bytes");
+            ExpectReadError([&] { return ReadPointCloud(path); }, path);
         }
     }
 }

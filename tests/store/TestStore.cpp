@@ -43,7 +43,12 @@ Scan RoomScan(uint32_t seed, const Eigen::Vector3d& centre, size_t n = 6000) {
     Scan scan;
     scan.T_world_sensor.translation() = centre;
     for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector3d d(u(rng), u(rng), u(rng));
+        // z, y, x, one draw each: argument order is unspecified (gcc right to left, clang left to
+        // right) and the scan must not depend on the compiler; this is the order gcc always used.
+        Eigen::Vector3d d;
+        d.z() = u(rng);
+        d.y() = u(rng);
+        d.x() = u(rng);
         const Eigen::Array3d half(6.0, 4.0, 1.5);
         const double t = (half / d.array().abs()).minCoeff();
         scan.points.push_back(d * t);

@@ -164,7 +164,12 @@ inline fs::path MakeSequence(const fs::path& dir, const SequenceSpec& spec = {})
         poses.push_back(T);
         std::vector<Eigen::Vector3d> points;
         for (int i = 0; i < spec.points_per_scan; ++i) {
-            Eigen::Vector3d d(u(rng), u(rng), u(rng));
+            // z, y, x, one draw each: argument order is unspecified (gcc right to left, clang
+            // left to right) and the scan must not depend on the compiler; gcc's order is kept.
+            Eigen::Vector3d d;
+            d.z() = u(rng);
+            d.y() = u(rng);
+            d.x() = u(rng);
             const double t = (spec.room_half_m.array() / d.array().abs()).minCoeff();
             points.push_back(d * t);
         }

@@ -43,7 +43,13 @@ fs::path MakeRoom(const fs::path& dir, bool pillar) {
         poses.push_back(T);
         std::vector<Eigen::Vector3d> points;
         while (points.size() < 20000) {
-            const Eigen::Vector3d d = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+            // z, y, x, one draw each: argument order is unspecified (gcc right to left, clang
+            // left to right) and the scan must not depend on the compiler; gcc's order is kept.
+            Eigen::Vector3d d;
+            d.z() = u(rng);
+            d.y() = u(rng);
+            d.x() = u(rng);
+            d.normalize();
             const Eigen::Vector3d o = T.translation();
             double t = INFINITY;  // to the room's walls (the room is centred on the origin)
             for (int a = 0; a < 3; ++a) {

@@ -31,8 +31,13 @@ std::vector<Eigen::Vector3d> WallPoints(double lean_deg, double length, double h
     const Eigen::Vector3d normal(0.0, std::cos(lean_deg * kRad), std::sin(lean_deg * kRad));
     std::vector<Eigen::Vector3d> out;
     for (size_t i = 0; i < n; ++i) {
-        out.push_back(origin + Eigen::Vector3d::UnitX() * u(rng) * length + up * u(rng) * height +
-                      normal * g(rng));
+        // One draw each, last term first: the operands of + are evaluated in an unspecified
+        // order and the points must not depend on the compiler (this is gcc's order).
+        const double across = g(rng);
+        const double high = u(rng);
+        const double along = u(rng);
+        out.push_back(origin + Eigen::Vector3d::UnitX() * along * length + up * high * height +
+                      normal * across);
     }
     return out;
 }
@@ -43,7 +48,12 @@ std::vector<Eigen::Vector3d> BushPoints(const Eigen::Vector3d& centre, double ra
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<Eigen::Vector3d> out;
     while (out.size() < n) {
-        const Eigen::Vector3d d(u(rng), u(rng), u(rng));
+        // z, y, x, one draw each: argument order is unspecified (gcc right to left, clang left to
+        // right) and the scan must not depend on the compiler; this is the order gcc always used.
+        Eigen::Vector3d d;
+        d.z() = u(rng);
+        d.y() = u(rng);
+        d.x() = u(rng);
         if (d.norm() <= 1.0) out.push_back(centre + radius * d);
     }
     return out;

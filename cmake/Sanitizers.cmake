@@ -1,0 +1,41 @@
+# Sanitizer builds (docs/reliability.md, "Sanitizers"), each in a build directory of its own, with
+# clang, instrumenting everything the build compiles so a bug in a library is caught where it is:
+#   STRATA_BUILD_FUZZ=ON    libFuzzer coverage + ASan + UBSan: tools/fuzz.sh, tools/sanitize.sh asan
+#   STRATA_SANITIZE=thread  ThreadSanitizer: tools/sanitize.sh tsan
+set(STRATA_SANITIZE "" CACHE STRING "Build everything with a sanitizer: empty or 'thread'")
+set_property(CACHE STRATA_SANITIZE PROPERTY STRINGS "" thread)
+
+if(STRATA_BUILD_FUZZ OR STRATA_SANITIZE)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "STRATA_BUILD_FUZZ and STRATA_SANITIZE need clang, but the C++ compiler "
+                        "is ${CMAKE_CXX_COMPILER_ID}: configure a fresh build directory with "
+                        "-DCMAKE_CXX_COMPILER=clang++ (tools/fuzz.sh and tools/sanitize.sh do)")
+  endif()
+  # After the build type's -O2 -g, so these win: -O1 and line tables only, to compile the
+  # OpenVDB-heavy files faster; line tables are all a sanitizer report needs.
+  add_compile_options(-O1 -gline-tables-only)
+endif()
+
+if(STRATA_BUILD_FUZZ AND STRATA_SANITIZE)
+  message(FATAL_ERROR "STRATA_BUILD_FUZZ builds with ASan + UBSan already; "
+                      "STRATA_SANITIZE=${STRATA_SANITIZE} needs a build directory of its own")
+elseif(STRATA_BUILD_FUZZ)
+  # Coverage for libFuzzer on everything; only the fuzz targets link libFuzzer's main
+  # (-fsanitize=fuzzer, tests/fuzz/CMakeLists.txt), so the same objects make the test binaries
+  # of the ASan + UBSan run too. The ignorelist gives the reason for each entry.
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined
+                      -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+                      -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/tests/fuzz/SanitizerIgnorelist.txt
+                      -Wno-unknown-warning-option)  # cmake/Warnings.cmake has gcc's -Wshadow=local
+  add_link_options(-fsanitize=address,undefined)
+elseif(STRATA_SANITIZE STREQUAL "thread")
+  # TBB's scheduler must be instrumented too, or every hand-over of work between its threads is
+  # reported as a race: tools/sanitize.sh builds libtbb from Debian's source package with TSan
+  # and puts it first on LD_LIBRARY_PATH for the tests (docs/reliability.md, "Sanitizers").
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer
+                      -Wno-unknown-warning-option)  # cmake/Warnings.cmake has gcc's -Wshadow=local
+  add_link_options(-fsanitize=thread)
+elseif(STRATA_SANITIZE)
+  message(FATAL_ERROR "STRATA_SANITIZE='${STRATA_SANITIZE}': the only value is 'thread' "
+                      "(ASan + UBSan come with STRATA_BUILD_FUZZ=ON, tools/sanitize.sh asan)")
+endif()

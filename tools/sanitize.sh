@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# Runs tests under clang's sanitizers; fails on a failing test or on any sanitizer report, also
+# one from a `strata` child process that a test expected to fail. docs/reliability.md, "Sanitizers".
+# Usage: tools/sanitize.sh asan [CTEST_ARGS...]
+#          every test with AddressSanitizer + UndefinedBehaviorSanitizer, in build-fuzz/: the
+#          objects of tools/fuzz.sh (same compiler and flags) with tests and tools added, so
+#          one compile of the libraries serves both.
+#        tools/sanitize.sh tsan [CTEST_ARGS...]
+#          the parallel paths with ThreadSanitizer, in build-tsan/: only the test programs in
+#          $tsan_targets are built and the tests matching $tsan_tests run. libtbb is built
+#          with TSan from Debian's source package of the installed libtbb-dev (fetched once into
+#          build-tsan/onetbb/ with apt-get and a private source list; the system's apt
+#          configuration is untouched), else every hand-over between TBB threads is a report.
+#   STRATA_BUILD_JOBS=2  build parallelism   STRATA_TEST_JOBS=2  ctest -j
+#   STRATA_SANITIZE_TARGETS="test_store"  build only these programs; pass the matching -R Store
+# Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
+# Tests read STRATA_SANITIZER (address or thread, set here) to shrink what is too slow there.
+set -euo pipefail
+shopt -s inherit_errexit  # BuildTsanTbb runs in $(...): stop at its first failure too
+root=$(cd "$(dirname "$0")/.." && pwd)
+mode=${1:-}
+if [[ $mode != asan && $mode != tsan ]]; then
+  echo "usage: tools/sanitize.sh asan|tsan [CTEST_ARGS...]" >&2
+  exit 2
+fi
+shift
+jobs=${STRATA_BUILD_JOBS:-$(nproc)}
+
+# The parallel paths: the integrator's TBB loops (ResultDoesNotDependOnThreadCount runs 1 and 4
+# threads), the store's parallel tile writes and reads with a reader thread against a writer,
+# reader processes against a writer process (StoreFaults runs `strata`, built with TSan too),
+# the simulator's Embree sweeps and the change detector's parallel tile loads. Tests of other
+# things (most store and fault tests take minutes under TSan) run under ASan only.
+tsan_targets=(test_integration test_store test_store_faults test_sim test_change)
+tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection)\.|^OctomapAgreement\.Synthetic'
+tsan_tests+='|^Store\.(SessionsEqualInMemory|OneWriterAtATime|ReadersSeeWholeCommits)'
+tsan_tests+='|^StoreFaults\.ReaderProcessesSeeWholeCommits'
+
+if ! command -v clang++ >/dev/null; then
+  echo "sanitize.sh: clang++ not found (tools/setup.sh installs it)" >&2
+  exit 1
+fi
+launcher=()
+if command -v ccache >/dev/null; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="$root"
+fi
+start=$(date +%s)
+
+# Builds libtbb with TSan from the source of the installed version into $1/tbb; prints the
+# folder holding libtbb.so.12.
+BuildTsanTbb() {
+  local dir=$1 version apt_dir lib
+  version=$(dpkg-query -W -f='${Version}' libtbb-dev)
+  lib=$(find "$dir/tbb" -name libtbb.so.12 2>/dev/null | head -1 || true)
+  if [[ -n $lib && -f $dir/onetbb/version && $(cat "$dir/onetbb/version") == "$version" ]]; then
+    dirname "$lib"
+    return
+  fi
+  rm -rf "$dir/onetbb" "$dir/tbb"
+  apt_dir="$dir/onetbb/apt"
+  mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$dir/onetbb/src"
+  {
+    printf 'deb-src http://deb.debian.org/debian %s main\n' bookworm bookworm-updates
+    echo 'deb-src http://deb.debian.org/debian-security bookworm-security main'
+  } >"$apt_dir/sources.list"
+  local apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources.list"
+                  -o Dir::Etc::SourceParts=/dev/null -o "Dir::State::Lists=$apt_dir/lists"
+                  -o "Dir::Cache=$apt_dir/cache")
+  apt-get "${apt_opts[@]}" update >&2
+  # apt-get warns that root downloads unsandboxed into a folder _apt cannot write: harmless.
+  if ! (cd "$dir/onetbb/src" &&
+        apt-get "${apt_opts[@]}" source --download-only "onetbb=$version" >/dev/null 2>&1); then
+    echo "sanitize.sh: no Debian source package onetbb=$version to build a TSan libtbb" >&2
+    exit 1
+  fi
+  # --no-check: apt-get has verified the files against the signed Sources index; the .dsc's own
+  # signature needs the maintainers' keys (debian-keyring), which the machine does not have.
+  dpkg-source --no-check -x "$dir"/onetbb/src/onetbb_*.dsc "$dir/onetbb/tree" >/dev/null
+  cmake -S "$dir/onetbb/tree" -B "$dir/tbb" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_COMPILER=clang++ -DTBB_SANITIZE=thread -DTBB_TEST=OFF \
+    -DTBBMALLOC_BUILD=OFF -DTBB_STRICT=OFF "${launcher[@]}" >/dev/null
+  cmake --build "$dir/tbb" -j "$jobs" >&2
+  echo "$version" >"$dir/onetbb/version"
+  dirname "$(find "$dir/tbb" -name libtbb.so.12 | head -1)"
+}
+
+common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++
+        -DSTRATA_BUILD_TESTS=ON -DSTRATA_BUILD_TOOLS=ON -DSTRATA_BUILD_BENCH=OFF
+        -DSTRATA_WARNINGS_AS_ERRORS="${STRATA_WERROR:-0}" "${launcher[@]}")
+if [[ $mode == asan ]]; then
+  build="$root/build-fuzz"
+  cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_BUILD_FUZZ=ON >/dev/null
+  cmake --build "$build" -j "$jobs" ${STRATA_SANITIZE_TARGETS:+--target $STRATA_SANITIZE_TARGETS}
+  filter=()
+  export STRATA_SANITIZER=address
+else
+  build="$root/build-tsan"
+  mkdir -p "$build"
+  tbb_lib=$(BuildTsanTbb "$build")
+  export LD_LIBRARY_PATH="$tbb_lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+  cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_SANITIZE=thread >/dev/null
+  cmake --build "$build" -j "$jobs" --target ${STRATA_SANITIZE_TARGETS:-${tsan_targets[*]}}
+  ldd "$build/tests/integration/test_integration" | grep -q "$tbb_lib/libtbb.so.12" \
+    || { echo "sanitize.sh: the tests do not load the TSan libtbb in $tbb_lib" >&2; exit 1; }
+  filter=(-R "$tsan_tests")
+  export STRATA_SANITIZER=thread
+fi
+echo "sanitize.sh: $mode build took $(($(date +%s) - start)) s"
+
+reports="$build/sanitizer-reports"
+rm -rf "$reports"
+mkdir -p "$reports"
+# Leak checking is off: OpenVDB and TBB keep process-lifetime allocations that are not bugs.
+export ASAN_OPTIONS="detect_leaks=0:log_path=$reports/asan"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:log_path=$reports/ubsan"
+export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$reports/tsan"
+# Programs left unbuilt on purpose show up in ctest as <program>_NOT_BUILT.
+[[ -n ${STRATA_SANITIZE_TARGETS:-} ]] && filter+=(-E _NOT_BUILT)
+test_start=$(date +%s)
+status=0
+ctest --test-dir "$build" --output-on-failure -j "${STRATA_TEST_JOBS:-$(nproc)}" \
+  "${filter[@]}" "$@" || status=$?
+end=$(date +%s)
+echo "sanitize.sh: $mode tests took $((end - test_start)) s, $((end - start)) s in all"
+if compgen -G "$reports/*" >/dev/null; then
+  echo "sanitize.sh: sanitizer reports from $(ls "$reports" | wc -l) processes:" >&2
+  for f in "$reports"/*; do echo "== $f" >&2; head -60 "$f" >&2; done
+  status=1
+fi
+exit $status
