@@ -17,6 +17,12 @@
 
 namespace strata::bench {
 
+/// The median of a set of timings (the upper one of an even count).
+inline double Median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
 using Clock = std::chrono::steady_clock;
 
 /// Seconds elapsed since `start`.

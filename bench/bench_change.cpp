@@ -23,16 +23,13 @@
 
 namespace {
 
+using strata::bench::Median;
+
 namespace fs = std::filesystem;
 using strata::bench::Clock;
 using strata::bench::Seconds;
 
 constexpr double kVoxel = 0.2;
-
-double Median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 struct Case {
     std::string name;

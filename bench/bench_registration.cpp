@@ -25,15 +25,12 @@
 
 namespace {
 
+using strata::bench::Median;
+
 namespace fs = std::filesystem;
 namespace reg = strata::registration;
 using strata::core::Scan;
 using strata::core::VoxelMap;
-
-double Median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 VoxelMap Integrate(const std::vector<Scan>& scans, double voxel,
                    const Eigen::Isometry3d& T = Eigen::Isometry3d::Identity()) {

@@ -21,15 +21,12 @@
 
 namespace {
 
+using strata::bench::Median;
+
 namespace fs = std::filesystem;
 using strata::core::VoxelMap;
 using strata::vehicles::VehicleConfig;
 using strata::vehicles::VehicleSource;
-
-double Median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 void PrintScore(const char* voxel, const char* name, const strata::testing::VehicleScore& s,
                 bool boxes) {

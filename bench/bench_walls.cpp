@@ -21,6 +21,8 @@
 
 namespace {
 
+using strata::bench::Median;
+
 namespace fs = std::filesystem;
 
 struct Case {
@@ -28,11 +30,6 @@ struct Case {
     std::string folder;
     double voxel = 0.2;
 };
-
-double Median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 int Run(const fs::path& data, int repeat) {
     const std::vector<Case> cases = {{"BALM, 89 scans", "balm", 0.2},
