@@ -51,17 +51,32 @@ void WriteFileAtomically(const fs::path& path, const std::function<void(std::ost
         const std::string reason = std::strerror(errno);
         Fail(path, tmp, "cannot create '" + tmp.string() + "' (" + reason + ")");
     }
+    // The stream state is the only reliable sign of a full disk: check it after the writes, the
+    // flush and the close. A file stream keeps no error code, so the cause is errno as the
+    // failing write(2) left it, read before any other call can change it.
+    int write_errno = 0;
     try {
+        errno = 0;
         write(os);
+        if (!os) write_errno = errno;
     } catch (const std::exception& e) {
         os.close();
         Fail(path, tmp, e.what());
     }
-    // The stream state is the only reliable sign of a full disk: check it after flush and close.
-    os.flush();
+    if (os) {
+        errno = 0;
+        os.flush();
+        if (!os) write_errno = errno;
+    }
     const bool written = os.good();
+    errno = 0;
     os.close();
-    if (!written || os.fail()) Fail(path, tmp, "write error (disk full or I/O error)");
+    if (written && os.fail()) write_errno = errno;
+    if (!written || os.fail()) {
+        Fail(path, tmp,
+             std::string("write error (") +
+                 (write_errno ? std::strerror(write_errno) : "disk full or I/O error") + ")");
+    }
     if (!SyncFile(tmp)) Fail(path, tmp, std::string("fsync failed (") + std::strerror(errno) + ")");
     std::error_code ec;
     fs::rename(tmp, path, ec);

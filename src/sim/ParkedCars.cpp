@@ -32,11 +32,17 @@ void ParseParkedCars(JsonReader& r, SceneAssembler& a) {
         v.type = type;
         v.size = vt.size;
         const Eigen::Vector2d left(-d.y(), d.x());
-        const Eigen::Vector2d xy =
-            from + (s + rng.Uniform(-0.4, 0.4)) * d + rng.Uniform(-0.1, 0.1) * left;
+        // One draw per statement: operands of + are evaluated in an unspecified order (gcc
+        // drew the sideways offset first, clang the one along the kerb), and a scene must not
+        // depend on the compiler. The order is the one gcc builds always had.
+        const double sideways_m = rng.Uniform(-0.1, 0.1);
+        const double along_m = rng.Uniform(-0.4, 0.4);
+        const Eigen::Vector2d xy = from + (s + along_m) * d + sideways_m * left;
         v.center = Eigen::Vector3d(xy.x(), xy.y(), a.GroundZ(xy.x(), xy.y()));
         // Some drivers park nose first, some reverse in; all a little crooked.
-        v.yaw_deg = yaw + (rng.Uniform() < 0.8 ? 0.0 : 180.0) + rng.Uniform(-1, 1) * jitter_deg;
+        const bool reversed = rng.Uniform() >= 0.8;
+        const double crooked_deg = rng.Uniform(-1, 1) * jitter_deg;
+        v.yaw_deg = yaw + (reversed ? 180.0 : 0.0) + crooked_deg;
         ObjectSpec o;
         o.name = prefix + "_" + std::to_string(slot);
         o.label = vt.label;

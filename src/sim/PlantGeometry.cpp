@@ -30,13 +30,21 @@ std::vector<Mesh> BuildPlantMeshes(const ObjectSpec& object, const PlantSpec& pl
     Mesh crown;
     crown.vertices.reserve(3 * leaves);
     for (size_t i = 0; i < leaves; ++i) {
+        // One draw per statement, z first: the order in which function arguments are evaluated
+        // is unspecified (gcc goes right to left, clang left to right), and a scene must not
+        // depend on the compiler. z, y, x is the order the gcc builds always had.
         Eigen::Vector3d q;
         do {
-            q = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1));
+            q.z() = rng.Uniform(-1, 1);
+            q.y() = rng.Uniform(-1, 1);
+            q.x() = rng.Uniform(-1, 1);
         } while (q.squaredNorm() > 1.0);
         const Eigen::Vector3d p = centre + q.cwiseProduct(radii);
-        const Eigen::Vector3d n =
-            Eigen::Vector3d(rng.Normal(), rng.Normal(), rng.Normal()).normalized();
+        Eigen::Vector3d n;
+        n.z() = rng.Normal();
+        n.y() = rng.Normal();
+        n.x() = rng.Normal();
+        n.normalize();
         const Eigen::Vector3d e1 = n.unitOrthogonal();
         const Eigen::Vector3d e2 = n.cross(e1);
         const double s = plant.leaf_size_m * rng.Uniform(0.6, 1.4);

@@ -461,10 +461,14 @@ TEST(StoreFaults, FullDiskFailsAndLeavesTheMapAsItWas) {
     }
 }
 
-// `strata ARGS` with fsync/fdatasync failing with EIO on every file whose path holds `on`.
-Result StrataWithEio(const std::string& on, const std::string& args) {
-    const std::string cmd = "STRATA_EIO_ON='" + on + "' LD_PRELOAD='" + STRATA_EIO_SHIM + "' '" +
-                            STRATA_BINARY + "' " + args + " 2>&1";
+// `strata ARGS` with calls failing on every file whose path holds `on` (tests/tools/EioShim.cpp):
+// by default fsync/fdatasync with EIO; `calls` "write" fails the writes, `error` "ENOSPC" says
+// the disk is full.
+Result StrataWithEio(const std::string& on, const std::string& args,
+                     const std::string& calls = "sync", const std::string& error = "EIO") {
+    const std::string cmd = "STRATA_EIO_ON='" + on + "' STRATA_EIO_CALLS=" + calls +
+                            " STRATA_EIO_ERRNO=" + error + " LD_PRELOAD='" + STRATA_EIO_SHIM +
+                            "' '" + STRATA_BINARY + "' " + args + " 2>&1";
     Result r;
     FILE* pipe = ::popen(cmd.c_str(), "r");
     char buf[4096];
@@ -494,6 +498,42 @@ TEST(StoreFaults, IoErrorsOnFlushFailTheCommitAndLeaveTheMap) {
         EXPECT_EQ(MapFiles(f.map), files_before) << on;
         const Result check = Strata("check " + f.map.string() + " --json");
         EXPECT_EQ(check.code, 0) << check.out;
+    }
+    const Result next = Strata(Join(IntegrateArgs(f.map, f.seq, 2)));
+    EXPECT_EQ(next.code, 0) << next.out;
+    EXPECT_EQ(SessionCount(f.map), 2u);
+}
+
+// The write itself fails, with EIO (a bad disk) or ENOSPC (a full one; a real full disk, not the
+// file-size limit of FullDiskFailsAndLeavesTheMapAsItWas): on the new tile files, then on the
+// catalog's write-ahead log. The commit fails with the file and the cause, the map stays the
+// map of the sessions before, byte for byte, `strata check` is clean, and the next commit works.
+TEST(StoreFaults, WriteErrorsFailTheCommitAndLeaveTheMap) {
+    const Fixture f = MakeMap("faults_write", 1);
+    const auto files_before = MapFiles(f.map);
+    const VoxelMap map_before = LoadLatest(f.map);
+    struct Case {
+        std::string on, error, named;
+    };
+    const std::vector<Case> cases{
+        {"/tiles/", "EIO", "Input/output error"},
+        {"/tiles/", "ENOSPC", "No space left on device"},
+        {"catalog.sqlite", "EIO", "catalog.sqlite: disk I/O error"},
+        {"catalog.sqlite", "ENOSPC", "catalog.sqlite: database or disk is full"}};
+    for (const Case& c : cases) {
+        const std::string what = c.error + " on " + c.on;
+        const Result r = StrataWithEio(c.on, Join(IntegrateArgs(f.map, f.seq, 2)), "write", c.error);
+        EXPECT_NE(r.code, 0) << what << ": " << r.out;
+        EXPECT_NE(r.out.find(c.named), std::string::npos) << what << ": " << r.out;
+        const std::string file = c.on == "/tiles/" ? (f.map / "tiles").string()
+                                                   : (f.map / "catalog.sqlite").string();
+        EXPECT_NE(r.out.find(file), std::string::npos) << what << ": " << r.out;
+        EXPECT_EQ(SessionCount(f.map), 1u) << what;
+        EXPECT_TRUE(SameMap(LoadLatest(f.map), map_before)) << what;
+        EXPECT_EQ(MapFiles(f.map), files_before) << what;
+        const Result check = Strata("check " + f.map.string() + " --json");
+        EXPECT_EQ(check.code, 0) << what << ": " << check.out;
+        EXPECT_TRUE(JsonIn(check.out)["unreferenced"].empty()) << what << ": " << check.out;
     }
     const Result next = Strata(Join(IntegrateArgs(f.map, f.seq, 2)));
     EXPECT_EQ(next.code, 0) << next.out;
