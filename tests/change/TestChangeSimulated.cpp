@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "TempPath.hpp"
 #include "strata/change/ChangeDetection.hpp"
 #include "strata/change/MapObserver.hpp"
 #include "strata/io/KittiSequence.hpp"
@@ -85,20 +86,11 @@ Hits ReadHits(const io::KittiSequence& seq, const std::set<int>& objects) {
 
 // Simulates the scene once per test binary, integrates both sessions into a store and reads the
 // two sessions' layers back.
-// Removed when the test binary exits.
-struct TempDir {
-    fs::path path = fs::temp_directory_path() / ("strata_change_sim_" + std::to_string(::getpid()));
-    ~TempDir() {
-        std::error_code ignored;
-        fs::remove_all(path, ignored);
-    }
-};
-
 const Simulated& Scene() {
-    static const TempDir temp;
+    static const fs::path temp = strata::test::TempPath("change_sim");
     static const Simulated scene = [] {
         Simulated s;
-        s.dir = temp.path;
+        s.dir = temp;
         fs::remove_all(s.dir);
         const fs::path scene_file =
             fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/street_two_sessions.json";

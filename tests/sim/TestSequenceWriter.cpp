@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "TempPath.hpp"
 #include "strata/io/PoseFiles.hpp"
 
 #include <fstream>
@@ -12,9 +13,7 @@ namespace strata::sim {
 namespace {
 
 std::filesystem::path TempDir(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / ("strata_sim_" + name);
-    std::filesystem::remove_all(dir);
-    return dir;
+    return strata::test::TempPath("sim_" + name);
 }
 
 template <typename T>

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "TempPath.hpp"
 #include "strata/sim/KittiIds.hpp"
 #include "strata/sim/SensorModel.hpp"
 #include "strata/sim/SimulateScene.hpp"
@@ -21,9 +22,7 @@ SimulateConfig QuickConfig() {
 }
 
 std::filesystem::path TempDir(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / ("strata_simulate_" + name);
-    std::filesystem::remove_all(dir);
-    return dir;
+    return strata::test::TempPath("simulate_" + name);
 }
 
 nlohmann::json ReadJson(const std::filesystem::path& path) {

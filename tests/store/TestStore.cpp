@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "MapDiff.hpp"
+#include "TempPath.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/store/MapStore.hpp"
 #include "strata/store/SessionWriter.hpp"
@@ -30,11 +31,7 @@ using strata::store::StoreSettings;
 constexpr double kVoxel = 0.1;
 constexpr double kTile = 3.2;  // 32 voxels: a 12 m room spans many tiles
 
-fs::path Temp(const std::string& name) {
-    const fs::path p = fs::temp_directory_path() / ("strata_store_" + name);
-    fs::remove_all(p);
-    return p;
-}
+fs::path Temp(const std::string& name) { return strata::test::TempPath("store_" + name); }
 
 // A 12 x 8 x 3 m room around `centre`, with labelled points (floor road, the rest building).
 Scan RoomScan(uint32_t seed, const Eigen::Vector3d& centre, size_t n = 6000) {

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "TempPath.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
 
@@ -181,29 +182,9 @@ inline fs::path MakeSequence(const fs::path& dir, const SequenceSpec& spec = {})
     return dir;
 }
 
-/// A scratch path under the temporary directory, removed first.
+/// A scratch path unique to this process, removed first and at exit: "strata_cli_NAME_PID".
 inline fs::path Temp(const std::string& name) {
-    const fs::path p = fs::temp_directory_path() / ("strata_cli_" + name);
-    fs::remove_all(p);
-    return p;
-}
-
-/// A scratch path unique to this process (CTest runs the tests of one binary in parallel
-/// processes), removed when the process exits. "name.ext" becomes "strata_cli_name_PID.ext".
-inline fs::path Scratch(const std::string& name) {
-    struct Registry {
-        std::vector<fs::path> paths;
-        ~Registry() {
-            std::error_code ignored;
-            for (const auto& p : paths) fs::remove_all(p, ignored);
-        }
-    };
-    static Registry registry;
-    // The process id goes before the extension, which some commands read ("map.ply").
-    const size_t dot = name.rfind('.');
-    const std::string stem = name.substr(0, dot), extension = dot == std::string::npos ? "" : name.substr(dot);
-    registry.paths.push_back(Temp(stem + "_" + std::to_string(::getpid()) + extension));
-    return registry.paths.back();
+    return strata::test::TempPath("cli_" + name);
 }
 
 }  // namespace strata::tools::test

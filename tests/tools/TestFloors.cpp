@@ -37,7 +37,7 @@ struct Building {
 // Simulated and integrated (one session per storey, each in its own frame) once per process.
 const Building& BuildingMap() {
     static const Building b = [] {
-        Building out{Scratch("floors_seq"), Scratch("floors_map")};
+        Building out{Temp("floors_seq"), Temp("floors_map")};
         const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/building.json";
         const Result sim = Strata("simulate --scene " + scene + " --out " + out.seq.string() +
                                   " --no-picture");  // 40 scans: the whole corridor
@@ -61,7 +61,7 @@ Eigen::Matrix4d FromJson(const json& T) {
 
 TEST(RegistrationFloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
     const Building& b = BuildingMap();
-    const fs::path map = Scratch("floors_stack");
+    const fs::path map = Temp("floors_stack");
     fs::copy(b.map, map, fs::copy_options::recursive);
     for (int k = 1; k <= 2; ++k) {
         const Result r = Strata("stack " + map.string() + " --floor-session floor_" +

@@ -37,9 +37,9 @@ struct Street {
 const Street& StreetData() {
     static const Street street = [] {
         Street s;
-        s.seq = Scratch("register_seq");
-        s.moved = Scratch("register_moved");
-        s.map = Scratch("register_map");
+        s.seq = Temp("register_seq");
+        s.moved = Temp("register_moved");
+        s.map = Temp("register_map");
         const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
         const Result sim = Strata("simulate --scene " + scene + " --out " + s.seq.string() +
                                   " --max-scans 12 --no-picture");
@@ -63,7 +63,7 @@ const Street& StreetData() {
 }
 
 fs::path CopyOfMap(const std::string& name) {
-    const fs::path dir = Scratch(name);
+    const fs::path dir = Temp(name);
     fs::copy(StreetData().map, dir, fs::copy_options::recursive);
     return dir;
 }
@@ -112,7 +112,7 @@ TEST(RegistrationCli, BadInputFailsNamingTheProblem) {
     EXPECT_NE(r.out.find("--kitti"), std::string::npos) << r.out;
     r = Strata("register " + s.map.string() + " --kitti " + s.seq.string() + " --init 1,2,3");
     EXPECT_NE(r.code, 0) << r.out;
-    r = Strata("register " + Scratch("no_such_map").string() + " --kitti " + s.seq.string());
+    r = Strata("register " + Temp("no_such_map").string() + " --kitti " + s.seq.string());
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("no_such_map"), std::string::npos) << r.out;
 }
@@ -149,7 +149,7 @@ TEST(RegistrationIntegrateAlignCli, ARefusedAlignmentCommitsNothing) {
 
 TEST(RegistrationIntegrateAlignCli, NeedsAnExistingMap) {
     const Street& s = StreetData();
-    const fs::path map = Scratch("align_new");
+    const fs::path map = Temp("align_new");
     const Result r =
         Strata("integrate " + map.string() + " --kitti " + s.seq.string() + " --align");
     EXPECT_NE(r.code, 0);

@@ -18,8 +18,8 @@ constexpr size_t kMinVehicles = 8;
 
 const fs::path& GarageMap() {
     static const fs::path map = [] {
-        const fs::path seq = Scratch("vehicles_seq");
-        const fs::path dir = Scratch("vehicles_map");
+        const fs::path seq = Temp("vehicles_seq");
+        const fs::path dir = Temp("vehicles_map");
         const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/parking.json";
         const Result sim = Strata("simulate --scene " + scene + " --out " + seq.string() +
                                   " --max-scans 12 --no-picture");
@@ -33,7 +33,7 @@ const fs::path& GarageMap() {
 }
 
 fs::path CopyOfGarage(const std::string& name) {
-    const fs::path dir = Scratch(name);
+    const fs::path dir = Temp(name);
     fs::copy(GarageMap(), dir, fs::copy_options::recursive);
     fs::remove(dir / "writer.lock");
     return dir;
@@ -67,8 +67,8 @@ TEST(VehiclesCli, ReportsTheFixedKeysForLabelledAndGeometricSourcesWithoutTouchi
 
 TEST(VehiclesCli, StoresTheCleanedMapAsOneCommitThatAsOfCanUndo) {
     const fs::path map = CopyOfGarage("vehicles_save");
-    const fs::path png = Scratch("vehicles.png");
-    const fs::path ply_before = Scratch("before.ply"), ply_after = Scratch("after.ply");
+    const fs::path png = Temp("vehicles.png");
+    const fs::path ply_before = Temp("before.ply"), ply_after = Temp("after.ply");
     ASSERT_EQ(Strata("export " + map.string() + " --out " + ply_before.string()).code, 0);
     const Result r = Strata("vehicles " + map.string() + " --png " + png.string());
     ASSERT_EQ(r.code, 0) << r.out;
@@ -82,7 +82,7 @@ TEST(VehiclesCli, StoresTheCleanedMapAsOneCommitThatAsOfCanUndo) {
     }
     // The export of the latest commit is the cleaned map; as of the session, the map as scanned.
     ASSERT_EQ(Strata("export " + map.string() + " --out " + ply_after.string()).code, 0);
-    const fs::path ply_as_of = Scratch("as_of.ply");
+    const fs::path ply_as_of = Temp("as_of.ply");
     ASSERT_EQ(Strata("export " + map.string() + " --as-of 1 --out " + ply_as_of.string()).code, 0);
     EXPECT_NE(ReadText(ply_after), ReadText(ply_before));
     EXPECT_EQ(ReadText(ply_as_of), ReadText(ply_before));
@@ -98,7 +98,7 @@ TEST(VehiclesCli, BadArgumentsAndFailedOutputsLeaveTheMapAsItWas) {
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("/nonexistent/dir/v.png"), std::string::npos) << r.out;
     EXPECT_EQ(MapFiles(map), before);
-    r = Strata("vehicles " + Scratch("no_such_map").string());
+    r = Strata("vehicles " + Temp("no_such_map").string());
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("no map"), std::string::npos) << r.out;
 }

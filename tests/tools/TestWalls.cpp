@@ -25,8 +25,8 @@ constexpr double kMinDistinctInliers = 0.99;
 // One map per test process (simulating and integrating takes a few seconds).
 const fs::path& StreetMap() {
     static const fs::path map = [] {
-        const fs::path seq = Scratch("walls_seq");
-        const fs::path dir = Scratch("walls_map");
+        const fs::path seq = Temp("walls_seq");
+        const fs::path dir = Temp("walls_map");
         const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
         const Result sim = Strata("simulate --scene " + scene + " --out " + seq.string() +
                                   " --max-scans 12 --no-picture");
@@ -40,7 +40,7 @@ const fs::path& StreetMap() {
 
 // A copy of the street map the test may change.
 fs::path CopyOfStreet(const std::string& name) {
-    const fs::path dir = Scratch(name);
+    const fs::path dir = Temp(name);
     fs::copy(StreetMap(), dir, fs::copy_options::recursive);
     fs::remove(dir / "writer.lock");
     return dir;
@@ -79,7 +79,7 @@ TEST(WallsCli, ReportsTheLeaningFacadeWithTheFixedKeysAndLeavesTheMapWithNoSave)
 
 TEST(WallsCli, WritesReportsPicturesAndGrids) {
     const fs::path map = CopyOfStreet("walls_files");
-    const fs::path out = Scratch("walls_out");
+    const fs::path out = Temp("walls_out");
     fs::create_directories(out);
     const Result r =
         Strata("walls " + map.string() + " --no-save --png " + (out / "w.png").string() +

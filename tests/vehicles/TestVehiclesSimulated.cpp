@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "ParkingEval.hpp"
+#include "TempPath.hpp"
 
 namespace strata::vehicles {
 namespace {
@@ -27,19 +28,10 @@ constexpr double kMaxChamferAt01M = 0.03;
 constexpr double kMinMatchedFractionGeometric = 0.8;
 constexpr double kMinFScoreGeometric = 0.97;
 
-struct TempDir {
-    fs::path path =
-        fs::temp_directory_path() / ("strata_vehicles_sim_" + std::to_string(::getpid()));
-    ~TempDir() {
-        std::error_code ignored;
-        fs::remove_all(path, ignored);
-    }
-};
-
 const ParkingCase& Parking() {
-    static const TempDir temp;
+    static const fs::path temp = strata::test::TempPath("vehicles_sim");
     static const ParkingCase c = testing::SimulateParking(
-        fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/parking.json", temp.path, kVoxel);
+        fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/parking.json", temp, kVoxel);
     return c;
 }
 

@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "TempPath.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/sim/SimulateScene.hpp"
@@ -58,31 +59,23 @@ struct Simulated {
     std::vector<TruthWall> truth;
 };
 
-struct TempDir {
-    fs::path path = fs::temp_directory_path() / ("strata_walls_sim_" + std::to_string(::getpid()));
-    ~TempDir() {
-        std::error_code ignored;
-        fs::remove_all(path, ignored);
-    }
-};
-
 const Simulated& Street() {
-    static const TempDir temp;
+    static const fs::path temp = strata::test::TempPath("walls_sim");
     static const Simulated scene = [] {
         Simulated s;
-        fs::remove_all(temp.path);
+        fs::remove_all(temp);
         sim::SimulateConfig config;
         config.write_picture = false;
         (void)sim::SimulateSceneToSequence(
-            fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/street.json", temp.path, config);
-        const io::KittiSequence seq = io::OpenKittiSequence(temp.path);
+            fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/street.json", temp, config);
+        const io::KittiSequence seq = io::OpenKittiSequence(temp);
         for (double voxel : kVoxelSizes) s.maps.emplace(voxel, core::VoxelMap::Create(voxel));
         for (size_t i = 0; i < seq.size(); ++i) {
             const core::Scan scan = io::ReadKittiScan(seq, i);
             for (auto& [voxel, map] : s.maps) integration::Integrator(map, {}).Integrate(scan);
         }
 
-        std::ifstream in(temp.path / "ground_truth.json");
+        std::ifstream in(temp / "ground_truth.json");
         const nlohmann::json j = nlohmann::json::parse(in);
         for (const auto& w : j.at("walls")) {
             TruthWall t;
