@@ -63,6 +63,7 @@ void FloorStackConfig::Validate() const {
     }
     slice.Validate();
     registration.Validate();
+    height.Validate();
 }
 
 FloorStackResult StackFloor(const std::vector<Eigen::Vector3d>& reference_map,
@@ -125,8 +126,19 @@ FloorStackResult StackFloor(const std::vector<Eigen::Vector3d>& reference_map,
     }
     out.result = results[chosen];
     out.candidates = std::move(results);
-    // Step 3: the floor's height from the reference and the bias.
+    // Step 3: the floor's height: the reference and the bias, then measured from the horizontal
+    // surfaces both storeys saw (docs/registration.md, step 5).
     out.result.T_map_source.translation().z() = reference_floor_z_m + config.z_bias_m;
+    out.height.z_m = out.result.T_map_source.translation().z();
+    if (!config.height.measure || !out.result.converged) return out;
+    out.height = MeasureFloorHeight(reference_map, reference_floor_z_m, floor_points,
+                                    out.result.T_map_source, config.height);
+    if (out.height.measured) {
+        out.result.T_map_source.translation().z() = out.height.z_m;
+    } else {
+        out.result.converged = false;
+        out.result.refusal = out.height.refusal;
+    }
     return out;
 }
 

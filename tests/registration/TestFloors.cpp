@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include "strata/integration/Integrator.hpp"
@@ -26,7 +27,9 @@ constexpr double kStackXyTolM = 0.05;
 constexpr double kStackYawTolDeg = 0.2;
 constexpr double kMaxZErrorRate = 0.01;
 constexpr double kLocalizationRmseM = 0.05;
-constexpr double kFloorHeightM = 3.5;  // building.json
+constexpr double kFloorHeightM = 3.5;  // building.json, building_stairwell.json
+// z-biases off by -150 mm, 0 and +150 mm (4.3 % of the storey height, within the +-0.6 m search).
+constexpr double kZBiasesM[] = {3.35, 3.5, 3.65};
 constexpr int kScansPerFloor = 40;     // the whole corridor (12 scans see 8 m of it)
 constexpr double kVoxel = 0.1;
 
@@ -36,34 +39,52 @@ struct Building {
     std::vector<io::KittiSequence> floors;
 };
 
-// Simulated once per test process; removed when it exits.
+// Simulates a scene of datasets/scenes (every session at most `max_scans` scans, 0: the scene's
+// own count); removed when the holder is destroyed.
+struct BuildingHolder {
+    Building b;
+    BuildingHolder(const std::string& scene_name, int max_scans) {
+        b.dir = fs::temp_directory_path() /
+                ("strata_floors_" + scene_name + "_" + std::to_string(::getpid()));
+        fs::remove_all(b.dir);
+        const fs::path scene =
+            fs::path(STRATA_SOURCE_DIR) / "datasets/scenes" / (scene_name + ".json");
+        b.spec = sim::LoadSceneSpec(scene);
+        sim::SimulateConfig config;
+        config.max_scans = max_scans;
+        config.write_picture = false;
+        const sim::SimulateReport report = sim::SimulateSceneToSequence(b.spec, b.dir, config);
+        for (const sim::SessionReport& s : report.sessions) {
+            b.floors.push_back(io::OpenKittiSequence(s.dir));
+        }
+    }
+    ~BuildingHolder() {
+        std::error_code ignored;
+        fs::remove_all(b.dir, ignored);
+    }
+};
+
+// building.json: three storeys, each session walks its corridor only. Simulated once per process.
 const Building& SimulatedBuilding() {
-    static const struct Holder {
-        Building b;
-        Holder() {
-            b.dir = fs::temp_directory_path() / ("strata_floors_" + std::to_string(::getpid()));
-            fs::remove_all(b.dir);
-            const fs::path scene = fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/building.json";
-            b.spec = sim::LoadSceneSpec(scene);
-            sim::SimulateConfig config;
-            config.max_scans = kScansPerFloor;
-            config.write_picture = false;
-            const sim::SimulateReport report = sim::SimulateSceneToSequence(b.spec, b.dir, config);
-            for (const sim::SessionReport& s : report.sessions) {
-                b.floors.push_back(io::OpenKittiSequence(s.dir));
-            }
-        }
-        ~Holder() {
-            std::error_code ignored;
-            fs::remove_all(b.dir, ignored);
-        }
-    } holder;
+    static const BuildingHolder holder("building", kScansPerFloor);
     return holder.b;
 }
 
-std::vector<Eigen::Vector3d> FloorCloud(const io::KittiSequence& seq) {
+// building_stairwell.json: two storeys whose sessions both walk half the flight between them.
+const Building& SimulatedStairwell() {
+    static const BuildingHolder holder("building_stairwell", 0);
+    return holder.b;
+}
+
+// The session's scans (those whose sensor pose `keep` accepts, session frame) as one cloud.
+std::vector<Eigen::Vector3d> FloorCloud(
+    const io::KittiSequence& seq,
+    const std::function<bool(const Eigen::Isometry3d&)>& keep = nullptr) {
     std::vector<core::Scan> scans;
-    for (size_t i = 0; i < seq.size(); ++i) scans.push_back(io::ReadKittiScan(seq, i));
+    for (size_t i = 0; i < seq.size(); ++i) {
+        core::Scan scan = io::ReadKittiScan(seq, i);
+        if (!keep || keep(scan.T_world_sensor)) scans.push_back(std::move(scan));
+    }
     SessionCloudConfig config;
     config.min_range_m = 0.5;
     config.cell_m = 0.05;
@@ -78,7 +99,10 @@ std::vector<Eigen::Vector3d> Moved(const std::vector<Eigen::Vector3d>& points,
     return out;
 }
 
-TEST(RegistrationFloors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
+// The corridor-only sessions of building.json share walls but no horizontal surface (the sensor
+// never looks into the stairwell or the shaft from both storeys): x, y and yaw are found and z is
+// refused, not guessed. The refused estimate keeps z = floor below + z-bias (exact here).
+TEST(RegistrationFloors, StacksTheCorridorOnlyBuildingInXyYawButRefusesToGuessZ) {
     const Building& b = SimulatedBuilding();
     ASSERT_EQ(b.floors.size(), 3u);
     const Eigen::Isometry3d T_map_world = b.spec.sessions[0].T_world_session.inverse();
@@ -90,7 +114,10 @@ TEST(RegistrationFloors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
         config.z_bias_m = kFloorHeightM;
         const FloorStackResult r = StackFloor(Moved(below, T_map_floor.back()),
                                               T_map_floor.back().translation().z(), cloud, config);
-        ASSERT_TRUE(r.result.converged) << "floor " << k << ": " << r.result.refusal;
+        EXPECT_GT(r.accepted, 0) << "floor " << k;
+        EXPECT_FALSE(r.result.converged) << "floor " << k;
+        EXPECT_FALSE(r.height.measured) << "floor " << k;
+        EXPECT_NE(r.result.refusal.find("z not measured"), std::string::npos) << r.result.refusal;
         const Eigen::Isometry3d truth = T_map_world * b.spec.sessions[k].T_world_session;
         const Eigen::Vector3d dt = r.result.T_map_source.translation() - truth.translation();
         const double dyaw = YawDeg(truth.inverse() * r.result.T_map_source);
@@ -105,7 +132,6 @@ TEST(RegistrationFloors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
             }
             return os.str();
         }();
-        EXPECT_LE(std::abs(dt.z()) / truth.translation().z(), kMaxZErrorRate) << "floor " << k;
         ::testing::Test::RecordProperty("floor" + std::to_string(k) + "_dx_m",
                                         std::to_string(dt.x()));
         ::testing::Test::RecordProperty("floor" + std::to_string(k) + "_dy_m",
@@ -117,6 +143,72 @@ TEST(RegistrationFloors, StacksTheSimulatedBuildingFromTheZBiasAlone) {
         T_map_floor.push_back(r.result.T_map_source);
         below = cloud;
     }
+}
+
+// building_stairwell.json: both storeys walked half the flight between them. Stacked from a
+// z-bias 150 mm too low, right, and 150 mm too high, z is measured from the steps and floor 0's
+// lobby (seen by floor 1 through the stair hole) to within 1 % of the storey height.
+TEST(RegistrationFloors, MeasuresZThroughTheStairwellFromAWrongZBias) {
+    const Building& b = SimulatedStairwell();
+    ASSERT_EQ(b.floors.size(), 2u);
+    const Eigen::Isometry3d T_map_world = b.spec.sessions[0].T_world_session.inverse();
+    const Eigen::Isometry3d truth = T_map_world * b.spec.sessions[1].T_world_session;
+    const std::vector<Eigen::Vector3d> below = FloorCloud(b.floors[0]);
+    const std::vector<Eigen::Vector3d> cloud = FloorCloud(b.floors[1]);
+    for (const double z_bias : kZBiasesM) {
+        FloorStackConfig config;
+        config.z_bias_m = z_bias;
+        const FloorStackResult r = StackFloor(below, 0.0, cloud, config);
+        ASSERT_TRUE(r.result.converged) << "z-bias " << z_bias << ": " << r.result.refusal;
+        ASSERT_TRUE(r.height.measured);
+        const Eigen::Vector3d dt = r.result.T_map_source.translation() - truth.translation();
+        const double dyaw = YawDeg(truth.inverse() * r.result.T_map_source);
+        EXPECT_LT(std::abs(dt.x()), kStackXyTolM) << "z-bias " << z_bias;
+        EXPECT_LT(std::abs(dt.y()), kStackXyTolM) << "z-bias " << z_bias;
+        EXPECT_LT(std::abs(dyaw), kStackYawTolDeg) << "z-bias " << z_bias;
+        EXPECT_LE(std::abs(dt.z()) / kFloorHeightM, kMaxZErrorRate)
+            << "z-bias " << z_bias << ": z " << r.height.z_m << ", " << r.height.matches
+            << " matches";
+        const std::string key = "zbias" + std::to_string(static_cast<int>(z_bias * 100.0));
+        ::testing::Test::RecordProperty(key + "_dz_m", std::to_string(dt.z()));
+        ::testing::Test::RecordProperty(key + "_dx_m", std::to_string(dt.x()));
+        ::testing::Test::RecordProperty(key + "_dy_m", std::to_string(dt.y()));
+        ::testing::Test::RecordProperty(key + "_dyaw_deg", std::to_string(dyaw));
+        ::testing::Test::RecordProperty(key + "_z_matches", std::to_string(r.height.matches));
+        ::testing::Test::RecordProperty(key + "_time_ms", std::to_string(r.result.time_ms));
+    }
+}
+
+// The same storeys without their walks into the core (scans at x < 7.5 m in the building: the
+// lobby and the stairwell). With floor 0's walk alone, floor 0 saw floor 1's ceiling through the
+// stair hole: z is measured from it. Without either walk, the walls still give x, y and yaw, but
+// from the corridors the storeys saw nothing horizontal in common: z is refused.
+TEST(RegistrationFloors, RefusesZWhenNeitherStoreyEnteredTheStairwell) {
+    const Building& b = SimulatedStairwell();
+    ASSERT_EQ(b.floors.size(), 2u);
+    const Eigen::Isometry3d T_map_world = b.spec.sessions[0].T_world_session.inverse();
+    constexpr double kCoreEndX = 7.5;  // the core is x < 7 m (BuildingGenerator)
+    auto corridor_only = [&](size_t k) {
+        const Eigen::Isometry3d T = T_map_world * b.spec.sessions[k].T_world_session;
+        return FloorCloud(b.floors[k], [&](const Eigen::Isometry3d& T_floor_sensor) {
+            return (T * T_floor_sensor).translation().x() >= kCoreEndX;
+        });
+    };
+    FloorStackConfig config;
+    config.z_bias_m = kZBiasesM[2];
+    const FloorStackResult one_walk =
+        StackFloor(FloorCloud(b.floors[0]), 0.0, corridor_only(1), config);
+    ASSERT_TRUE(one_walk.result.converged) << one_walk.result.refusal;
+    const double truth_z = (T_map_world * b.spec.sessions[1].T_world_session).translation().z();
+    EXPECT_LE(std::abs(one_walk.height.z_m - truth_z) / kFloorHeightM, kMaxZErrorRate);
+    ::testing::Test::RecordProperty("one_walk_dz_m", std::to_string(one_walk.height.z_m - truth_z));
+
+    const FloorStackResult r = StackFloor(corridor_only(0), 0.0, corridor_only(1), config);
+    EXPECT_GT(r.accepted, 0);
+    EXPECT_FALSE(r.result.converged);
+    EXPECT_FALSE(r.height.measured);
+    EXPECT_NE(r.result.refusal.find("z not measured"), std::string::npos) << r.result.refusal;
+    EXPECT_LT(r.height.matches, config.height.min_matches);
 }
 
 TEST(RegistrationFloors, LocalizesEveryScanOfAFloorInItsSlice) {
@@ -181,6 +273,12 @@ TEST(RegistrationFloors, SliceAndConfigChecks) {
     config.yaw_step_deg = 0.0;
     EXPECT_THROW(config.Validate(), std::invalid_argument);
     EXPECT_THROW((void)StackFloor({}, 0.0, {}, FloorStackConfig{}), std::invalid_argument);
+    FloorHeightConfig height;
+    height.inlier_m = 0.0;
+    EXPECT_THROW(height.Validate(), std::invalid_argument);
+    height = FloorHeightConfig{};
+    height.slab_band_m = height.search_m;
+    EXPECT_THROW(height.Validate(), std::invalid_argument);
 }
 
 }  // namespace

@@ -34,22 +34,27 @@ struct Building {
     fs::path map;
 };
 
-// Simulated and integrated (one session per storey, each in its own frame) once per process.
+// A scene of datasets/scenes simulated and integrated, one session per storey, each in its own
+// frame.
+Building SimulateAndIntegrate(const std::string& scene_name, int storeys) {
+    Building out{Temp(scene_name + "_seq"), Temp(scene_name + "_map")};
+    const std::string scene =
+        std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/" + scene_name + ".json";
+    const Result sim =
+        Strata("simulate --scene " + scene + " --out " + out.seq.string() + " --no-picture");
+    EXPECT_EQ(sim.code, 0) << sim.out;
+    for (int k = 0; k < storeys; ++k) {
+        const Result r = Strata("integrate " + out.map.string() + " --voxel 0.1 --kitti " +
+                                (out.seq / ("session_" + std::to_string(k))).string() +
+                                " --name floor_" + std::to_string(k));
+        EXPECT_EQ(r.code, 0) << r.out;
+    }
+    return out;
+}
+
+// building.json (40 scans per storey: the whole corridor), once per process.
 const Building& BuildingMap() {
-    static const Building b = [] {
-        Building out{Temp("floors_seq"), Temp("floors_map")};
-        const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/building.json";
-        const Result sim = Strata("simulate --scene " + scene + " --out " + out.seq.string() +
-                                  " --no-picture");  // 40 scans: the whole corridor
-        EXPECT_EQ(sim.code, 0) << sim.out;
-        for (int k = 0; k < 3; ++k) {
-            const Result r = Strata("integrate " + out.map.string() + " --voxel 0.1 --kitti " +
-                                    (out.seq / ("session_" + std::to_string(k))).string() +
-                                    " --name floor_" + std::to_string(k));
-            EXPECT_EQ(r.code, 0) << r.out;
-        }
-        return out;
-    }();
+    static const Building b = SimulateAndIntegrate("building", 3);
     return b;
 }
 
@@ -59,19 +64,26 @@ Eigen::Matrix4d FromJson(const json& T) {
     return m;
 }
 
+// The corridor-only storeys share no horizontal surface: z is refused (nothing recorded) unless
+// --z-bias-only takes it from the z-bias (exact in the simulator).
 TEST(RegistrationFloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
     const Building& b = BuildingMap();
     const fs::path map = Temp("floors_stack");
     fs::copy(b.map, map, fs::copy_options::recursive);
+    const Result refused = Strata("stack " + map.string() + " --floor-session floor_1 --json");
+    EXPECT_NE(refused.code, 0);
+    EXPECT_NE(refused.out.find("z not measured"), std::string::npos) << refused.out;
+    EXPECT_TRUE(store::MapStore::Open(map, store::MapStore::Access::kRead).Floors().empty());
     for (int k = 1; k <= 2; ++k) {
         const Result r = Strata("stack " + map.string() + " --floor-session floor_" +
-                                std::to_string(k) + " --z-bias 3.5 --json");
+                                std::to_string(k) + " --z-bias 3.5 --z-bias-only --json");
         ASSERT_EQ(r.code, 0) << r.out;
         const json j = json::parse(r.out.substr(r.out.find('{')));
         for (const char* key : {"T", "converged", "rmse_m", "overlap", "time_ms"}) {
             EXPECT_TRUE(j.contains(key)) << key;
         }
         EXPECT_EQ(j["floor"].get<int>(), k);
+        EXPECT_FALSE(j["z_measured"].get<bool>());
         const Eigen::Isometry3d T(FromJson(j["T"]));
         const Eigen::Isometry3d truth = Frame(k);
         const Eigen::Vector3d dt = T.translation() - truth.translation();
@@ -99,6 +111,33 @@ TEST(RegistrationFloorsCli, StacksTwoFloorsAndLocalizesAScanOnTheFirst) {
     const json j = json::parse(r.out.substr(r.out.find('{')));
     const Eigen::Isometry3d T(FromJson(j["T"]));
     EXPECT_LT((T.translation() - truth.translation()).norm(), kLocalizeTolM) << r.out;
+}
+
+// building_stairwell.json: both storeys walked half the flight. From a z-bias 150 mm too high,
+// z is measured through the stairwell, printed and recorded in the catalog.
+TEST(RegistrationFloorsCli, MeasuresAndRecordsZThroughTheStairwell) {
+    static const Building b = SimulateAndIntegrate("building_stairwell", 2);
+    constexpr double kStoreyM = 3.5;
+    const Result r =
+        Strata("stack " + b.map.string() + " --floor-session floor_1 --z-bias 3.65 --json");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const json j = json::parse(r.out.substr(r.out.find('{')));
+    for (const char* key :
+         {"T", "converged", "rmse_m", "overlap", "time_ms", "z_m", "z_measured"}) {
+        EXPECT_TRUE(j.contains(key)) << key;
+    }
+    EXPECT_TRUE(j["z_measured"].get<bool>());
+    const Eigen::Isometry3d T(FromJson(j["T"]));
+    const Eigen::Isometry3d truth = Frame(1);
+    const Eigen::Vector3d dt = T.translation() - truth.translation();
+    EXPECT_LT(std::abs(dt.x()), kXyTolM) << r.out;
+    EXPECT_LT(std::abs(dt.y()), kXyTolM) << r.out;
+    EXPECT_LE(std::abs(dt.z()) / kStoreyM, kMaxZErrorRate) << r.out;
+    EXPECT_NEAR(j["z_m"].get<double>(), T.translation().z(), 1e-9);
+    const store::MapStore store = store::MapStore::Open(b.map, store::MapStore::Access::kRead);
+    ASSERT_EQ(store.Floors().size(), 2u);
+    EXPECT_NEAR(store.Floors()[1].z_m, kStoreyM, kStoreyM * kMaxZErrorRate);
+    EXPECT_NEAR(store.Floors()[1].T_map_floor(2, 3), T.translation().z(), 1e-6);
 }
 
 TEST(RegistrationFloorsCli, RefusesUnknownFloorsAndSessions) {

@@ -44,6 +44,7 @@ struct StackArgs {
     std::string map;
     std::string session;
     double z_bias = 3.5;
+    bool z_bias_only = false;
     bool json = false;
     AlignArgs align;
     reg::FloorSlice slice;
@@ -79,6 +80,7 @@ void RunStack(const StackArgs& args) {
     reg::FloorStackConfig config;
     config.z_bias_m = args.z_bias;
     config.slice = args.slice;
+    config.height.measure = !args.z_bias_only;
     config.registration.min_overlap = args.align.config.min_overlap;
     config.registration.max_rmse_m = args.align.config.max_rmse_m;
     const std::vector<Eigen::Vector3d> reference =
@@ -101,7 +103,22 @@ void RunStack(const StackArgs& args) {
     j["starts"] = r.starts;
     j["session"] = session;
     j["below"] = below.index;
+    // z: measured from the surfaces both storeys saw, or the z-bias alone (--z-bias-only).
+    j["z_measured"] = r.height.measured;
+    j["z_bias_m"] = args.z_bias;
+    j["dz_m"] = r.height.dz_m;
+    j["z_matches"] = r.height.matches;
+    j["z_rmse_m"] = r.height.rmse_m;
     PrintJsonOrText(j, a, args.json, record.index, record.z_m);
+    if (!args.json) {
+        std::cout << (r.height.measured ? "z measured: " : "z not measured (z-bias): ")
+                  << record.z_m << " m";
+        if (r.height.measured) {
+            std::cout << ", " << r.height.dz_m << " m from the z-bias, " << r.height.matches
+                      << " points on shared horizontal surfaces, rmse " << r.height.rmse_m << " m";
+        }
+        std::cout << "\n";
+    }
     RequireAccepted(a, "stacking session " + std::to_string(session));
     if (map.Floors().empty()) map.RecordFloor(base);
     map.RecordFloor(record);
@@ -184,14 +201,20 @@ void RegisterFloors(CLI::App& app) {
         "Example:\n"
         "  strata stack building.strata --floor-session floor_1 --z-bias 3.5 --json\n"
         "The first stack makes the oldest other session floor 0. x, y and yaw come from the walls\n"
-        "both floors share (planar ICP over a yaw search, or from --init), z from the floor below\n"
-        "plus --z-bias. The floor's frame and height are recorded in the catalog; the voxels stay\n"
-        "as integrated. Refused alignments record nothing.");
+        "both floors share (planar ICP over a yaw search, or from --init); z is measured from the\n"
+        "horizontal surfaces both saw (stairs, landings, a shaft's bottom through the slab's "
+        "holes)\n"
+        "within 0.6 m of the floor below plus --z-bias, and refused when they share too few\n"
+        "(--z-bias-only: z = floor below + --z-bias, not measured). The floor's frame and height\n"
+        "are recorded in the catalog; the voxels stay as integrated. Refused alignments record\n"
+        "nothing.");
     cmd->add_option("MAP", stack->map, "Map directory")->required();
     cmd->add_option("--floor-session", stack->session, "Session (id or name) of the floor")
         ->required();
     cmd->add_option("--z-bias", stack->z_bias, "Height of the floor above the one below (m)")
         ->capture_default_str();
+    cmd->add_flag("--z-bias-only", stack->z_bias_only,
+                  "Do not measure z: the floor below plus --z-bias");
     cmd->add_option("--l1", stack->slice.l1_m, "Wall band: above the floor surface (m)")
         ->capture_default_str();
     cmd->add_option("--l2", stack->slice.l2_m, "Wall band: below this height (m)")

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "strata/registration/FloorHeight.hpp"
 #include "strata/registration/Register.hpp"
 
 namespace strata::registration {
@@ -27,6 +28,7 @@ struct FloorStackConfig {
     /// Planar ICP (set internally); storeys share walls only, so overlap is lower than for a
     /// session of the same place.
     RegistrationConfig registration = DefaultRegistration();
+    FloorHeightConfig height;  ///< z measured after x, y and yaw (or the z-bias alone)
 
     /// @brief Throws std::invalid_argument naming the field when a value is out of range.
     void Validate() const;
@@ -39,12 +41,15 @@ struct FloorStackResult {
     int starts = 0;
     int accepted = 0;
     std::vector<RegistrationResult> candidates;  ///< one per start, in start order
+    FloorHeightResult height;  ///< z: measured, or why not (then `result` is refused)
 };
 
 /// @brief Aligns a floor mapped on its own (points in its frame, z = 0 at its floor surface) to
 /// the floor below it (points in the map frame, floor surface at `reference_floor_z_m`): x, y
 /// and yaw by planar point-to-plane ICP of the wall bands (the shared vertical structure), over
-/// a yaw search when no guess is given; z = reference_floor_z_m + z_bias_m.
+/// a yaw search when no guess is given; then z from the horizontal surfaces both storeys saw,
+/// searched around reference_floor_z_m + z_bias_m (MeasureFloorHeight). A z that cannot be
+/// measured refuses the result, unless `config.height.measure` is false (z = floor below + bias).
 /// @param guess T_map_floor to start from instead of the search (its z is replaced).
 [[nodiscard]] FloorStackResult StackFloor(const std::vector<Eigen::Vector3d>& reference_map,
                                           double reference_floor_z_m,
