@@ -88,9 +88,12 @@ private:
     [[nodiscard]] int64_t Cell(double v) const {
         return static_cast<int64_t>(std::floor(v * inv_cell_));
     }
-    [[nodiscard]] static int64_t Key(int64_t x, int64_t y) { return (x << 32) ^ (y & 0xffffffff); }
+    // Unsigned: shifting a negative signed value is undefined (UBSan caught it).
+    [[nodiscard]] static uint64_t Key(int64_t x, int64_t y) {
+        return (static_cast<uint64_t>(x) << 32) ^ (static_cast<uint64_t>(y) & 0xffffffffU);
+    }
     double inv_cell_;
-    std::unordered_map<int64_t, std::vector<double>> columns_;
+    std::unordered_map<uint64_t, std::vector<double>> columns_;
 };
 
 // Matched points and the mean vertical residual at offset `dz`: each floor point's nearest
