@@ -8,9 +8,9 @@
 #        tools/sanitize.sh tsan [CTEST_ARGS...]
 #          the parallel paths with ThreadSanitizer, in build-tsan/: only the test programs in
 #          $tsan_targets are built and the tests matching $tsan_tests run. libtbb is built
-#          with TSan from Debian's source package of the installed libtbb-dev (fetched once into
-#          build-tsan/onetbb/ with apt-get and a private source list; the system's apt
-#          configuration is untouched), else every hand-over between TBB threads is a report.
+#          with TSan from Debian's source package of the installed libtbb-dev, which
+#          tools/setup.sh fetches (no download here), else every hand-over between TBB threads
+#          is a report.
 #   STRATA_BUILD_JOBS=2  build parallelism   STRATA_TEST_JOBS=2  ctest -j
 #   STRATA_SANITIZE_TARGETS="test_store"  build only these programs; pass the matching -R Store
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
@@ -28,13 +28,15 @@ jobs=${STRATA_BUILD_JOBS:-$(nproc)}
 
 # The parallel paths: the integrator's TBB loops (ResultDoesNotDependOnThreadCount runs 1 and 4
 # threads), the store's parallel tile writes and reads with a reader thread against a writer,
-# reader processes against a writer process (StoreFaults runs `strata`, built with TSan too),
-# the simulator's Embree sweeps and the change detector's parallel tile loads. Tests of other
-# things (most store and fault tests take minutes under TSan) run under ASan only.
-tsan_targets=(test_integration test_store test_store_faults test_sim test_change)
-tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection)\.|^OctomapAgreement\.Synthetic'
+# the simulator's Embree sweeps, the change detector's parallel tile loads, the vehicle stage's
+# Embree ray checks and registration's parallel matching. Reader processes against a writer
+# process (StoreFaults) are left to ASan: TSan sees threads, not processes, and the store's
+# threads are the in-process reader test's. Tests of other things (most store tests take
+# minutes under TSan) run under ASan only.
+tsan_targets=(test_integration test_store test_sim test_change test_vehicles test_registration)
+tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection|RayCheck|ClearVehicles)\.'
+tsan_tests+='|^OctomapAgreement\.Synthetic|^RegistrationIcp\.Recovers'
 tsan_tests+='|^Store\.(SessionsEqualInMemory|OneWriterAtATime|ReadersSeeWholeCommits)'
-tsan_tests+='|^StoreFaults\.ReaderProcessesSeeWholeCommits'
 
 if ! command -v clang++ >/dev/null; then
   echo "sanitize.sh: clang++ not found (tools/setup.sh installs it)" >&2
@@ -47,36 +49,26 @@ if command -v ccache >/dev/null; then
 fi
 start=$(date +%s)
 
-# Builds libtbb with TSan from the source of the installed version into $1/tbb; prints the
-# folder holding libtbb.so.12.
+# Builds libtbb with TSan from Debian's source package of the installed version (tools/setup.sh
+# fetches it into /var/cache/strata/) into $1/tbb; prints the folder holding libtbb.so.12.
 BuildTsanTbb() {
-  local dir=$1 version apt_dir lib
+  local dir=$1 version source lib
   version=$(dpkg-query -W -f='${Version}' libtbb-dev)
+  source=${STRATA_TBB_SOURCE_DIR:-/var/cache/strata/onetbb-$version}
   lib=$(find "$dir/tbb" -name libtbb.so.12 2>/dev/null | head -1 || true)
   if [[ -n $lib && -f $dir/onetbb/version && $(cat "$dir/onetbb/version") == "$version" ]]; then
     dirname "$lib"
     return
   fi
-  rm -rf "$dir/onetbb" "$dir/tbb"
-  apt_dir="$dir/onetbb/apt"
-  mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$dir/onetbb/src"
-  {
-    printf 'deb-src http://deb.debian.org/debian %s main\n' bookworm bookworm-updates
-    echo 'deb-src http://deb.debian.org/debian-security bookworm-security main'
-  } >"$apt_dir/sources.list"
-  local apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources.list"
-                  -o Dir::Etc::SourceParts=/dev/null -o "Dir::State::Lists=$apt_dir/lists"
-                  -o "Dir::Cache=$apt_dir/cache")
-  apt-get "${apt_opts[@]}" update >&2
-  # apt-get warns that root downloads unsandboxed into a folder _apt cannot write: harmless.
-  if ! (cd "$dir/onetbb/src" &&
-        apt-get "${apt_opts[@]}" source --download-only "onetbb=$version" >/dev/null 2>&1); then
-    echo "sanitize.sh: no Debian source package onetbb=$version to build a TSan libtbb" >&2
+  if ! compgen -G "$source/onetbb_*.dsc" >/dev/null; then
+    echo "sanitize.sh: no source of libtbb $version in $source: run tools/setup.sh" >&2
     exit 1
   fi
-  # --no-check: apt-get has verified the files against the signed Sources index; the .dsc's own
-  # signature needs the maintainers' keys (debian-keyring), which the machine does not have.
-  dpkg-source --no-check -x "$dir"/onetbb/src/onetbb_*.dsc "$dir/onetbb/tree" >/dev/null
+  rm -rf "$dir/onetbb" "$dir/tbb"
+  mkdir -p "$dir/onetbb"
+  # --no-check: apt-get verified the files against the signed Sources index when setup.sh fetched
+  # them; the .dsc's own signature needs the maintainers' keys (debian-keyring), not installed.
+  dpkg-source --no-check -x "$source"/onetbb_*.dsc "$dir/onetbb/tree" >/dev/null
   cmake -S "$dir/onetbb/tree" -B "$dir/tbb" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_COMPILER=clang++ -DTBB_SANITIZE=thread -DTBB_TEST=OFF \
     -DTBBMALLOC_BUILD=OFF -DTBB_STRICT=OFF "${launcher[@]}" >/dev/null

@@ -28,6 +28,37 @@ if ((${#missing[@]})); then
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+# The source package of the installed libtbb, for tools/sanitize.sh tsan: ThreadSanitizer needs
+# a libtbb built with it (docs/reliability.md, "Sanitizers"). Fetched here, with the packages, so
+# that builds never download; apt-get checks the files against Debian's signed index. A private
+# source list and state keep the machine's apt configuration untouched.
+tbb_version=$(dpkg-query -W -f='${Version}' libtbb-dev)
+tbb_source=${STRATA_TBB_SOURCE_DIR:-/var/cache/strata/onetbb-$tbb_version}
+if ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
+  sudo_cmd=()
+  [[ $(id -u) -eq 0 ]] || sudo_cmd=(sudo)
+  apt_dir=$(mktemp -d)
+  trap 'rm -rf "$apt_dir"' EXIT
+  mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial"
+  {
+    printf 'deb-src http://deb.debian.org/debian %s main\n' bookworm bookworm-updates
+    echo 'deb-src http://deb.debian.org/debian-security bookworm-security main'
+  } >"$apt_dir/sources.list"
+  apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources.list" -o Dir::Etc::SourceParts=/dev/null
+            -o "Dir::State::Lists=$apt_dir/lists" -o "Dir::Cache=$apt_dir/cache"
+            -o APT::Sandbox::User=root)  # the private folders are not the _apt user's
+  "${sudo_cmd[@]}" apt-get "${apt_opts[@]}" update
+  "${sudo_cmd[@]}" mkdir -p "$tbb_source.partial"
+  (cd "$tbb_source.partial" &&
+     "${sudo_cmd[@]}" apt-get "${apt_opts[@]}" source --download-only "onetbb=$tbb_version" \
+       >/dev/null 2>&1) || {
+    echo "setup.sh: could not fetch Debian's source package onetbb=$tbb_version" >&2
+    exit 1
+  }
+  "${sudo_cmd[@]}" rm -rf "$tbb_source"
+  "${sudo_cmd[@]}" mv "$tbb_source.partial" "$tbb_source"
+fi
+
 if [[ "${1:-}" == "--build" ]]; then
   root=$(cd "$(dirname "$0")/.." && pwd)
   cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release
