@@ -106,7 +106,10 @@ mkdir -p "$reports"
 # Leak checking is off: OpenVDB and TBB keep process-lifetime allocations that are not bugs.
 export ASAN_OPTIONS="detect_leaks=0:log_path=$reports/asan"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:log_path=$reports/ubsan"
+# Suppressions only for races inside OpenVDB's and Embree's uninstrumented TBB loops; the file
+# gives the reason for each.
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$reports/tsan"
+TSAN_OPTIONS+=":suppressions=$root/tools/tsan-suppressions.txt"
 # Programs left unbuilt on purpose show up in ctest as <program>_NOT_BUILT.
 [[ -n ${STRATA_SANITIZE_TARGETS:-} ]] && filter+=(-E _NOT_BUILT)
 test_start=$(date +%s)
