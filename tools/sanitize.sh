@@ -9,8 +9,8 @@
 #          the parallel paths with ThreadSanitizer, in build-tsan/: only the test programs in
 #          $tsan_targets are built and the tests matching $tsan_tests run. libtbb is built
 #          with TSan from Debian's source package of the installed libtbb-dev, which
-#          tools/setup.sh fetches (no download here), else every hand-over between TBB threads
-#          is a report.
+#          `tools/setup.sh --sanitizers` fetches (no download here), else every hand-over
+#          between TBB threads is a report.
 #   STRATA_BUILD_JOBS=2  build parallelism   STRATA_TEST_JOBS=2  ctest -j
 #   STRATA_SANITIZE_TARGETS="test_store"  build only these programs; pass the matching -R Store
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
@@ -61,7 +61,7 @@ BuildTsanTbb() {
     return
   fi
   if ! compgen -G "$source/onetbb_*.dsc" >/dev/null; then
-    echo "sanitize.sh: no source of libtbb $version in $source: run tools/setup.sh" >&2
+    echo "sanitize.sh: no source of libtbb $version in $source: run tools/setup.sh --sanitizers" >&2
     exit 1
   fi
   rm -rf "$dir/onetbb" "$dir/tbb"

@@ -1,8 +1,19 @@
 #!/usr/bin/env bash
 # Installs strata's build dependencies from Debian 12 packages (idempotent; run as root or with sudo).
-# Usage: tools/setup.sh            install only
-#        tools/setup.sh --build    install, then configure and build into build/
+# Usage: tools/setup.sh                install only
+#        tools/setup.sh --build        install, then configure and build into build/
+#        tools/setup.sh --sanitizers   install, and fetch the source of libtbb for
+#                                      tools/sanitize.sh tsan (.ci/run does)
 set -euo pipefail
+build=0
+sanitizers=0
+for arg in "$@"; do
+  case $arg in
+    --build) build=1 ;;
+    --sanitizers) sanitizers=1 ;;
+    *) echo "usage: tools/setup.sh [--build] [--sanitizers]" >&2; exit 2 ;;
+  esac
+done
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config
@@ -34,7 +45,7 @@ fi
 # source list and state keep the machine's apt configuration untouched.
 tbb_version=$(dpkg-query -W -f='${Version}' libtbb-dev)
 tbb_source=${STRATA_TBB_SOURCE_DIR:-/var/cache/strata/onetbb-$tbb_version}
-if ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
+if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   sudo_cmd=()
   [[ $(id -u) -eq 0 ]] || sudo_cmd=(sudo)
   apt_dir=$(mktemp -d)
@@ -59,7 +70,7 @@ if ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   "${sudo_cmd[@]}" mv "$tbb_source.partial" "$tbb_source"
 fi
 
-if [[ "${1:-}" == "--build" ]]; then
+if ((build)); then
   root=$(cd "$(dirname "$0")/.." && pwd)
   cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release
   cmake --build "$root/build"
