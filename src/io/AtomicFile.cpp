@@ -1,4 +1,4 @@
-#include "io/AtomicFile.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -11,7 +11,9 @@
 #include <string>
 #include <system_error>
 
-namespace strata::io::detail {
+#include "strata/core/Error.hpp"
+
+namespace strata::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -36,14 +38,14 @@ bool SyncFile(const fs::path& file) {
 [[noreturn]] void Fail(const fs::path& path, const fs::path& tmp, const std::string& why) {
     std::error_code ignored;
     fs::remove(tmp, ignored);
-    throw std::runtime_error("cannot write '" + path.string() + "': " + why);
+    throw IoError("cannot write '" + path.string() + "': " + why);
 }
 
 }  // namespace
 
 void WriteFileAtomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
     if (path.empty() || !path.has_filename()) {
-        throw std::invalid_argument("output path '" + path.string() + "' does not name a file");
+        throw InvalidArgumentError("output path '" + path.string() + "' does not name a file");
     }
     const fs::path tmp = TemporarySibling(path);
     std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
@@ -84,4 +86,4 @@ void WriteFileAtomically(const fs::path& path, const std::function<void(std::ost
         Fail(path, tmp, "cannot rename '" + tmp.string() + "' into place (" + ec.message() + ")");
 }
 
-}  // namespace strata::io::detail
+}  // namespace strata::io

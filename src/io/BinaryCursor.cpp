@@ -1,4 +1,4 @@
-#include "io/BinaryCursor.hpp"
+#include "BinaryCursor.hpp"
 
 #include <algorithm>
 #include <fstream>

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/AtomicFile.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 namespace strata::io {
 namespace {
@@ -188,7 +188,7 @@ void WritePng(const RgbImage& image, const std::filesystem::path& path) {
         png_image_free(&png);
         throw std::runtime_error("cannot encode PNG '" + path.string() + "': " + message);
     }
-    detail::WriteFileAtomically(path, [&](std::ostream& os) {
+    WriteFileAtomically(path, [&](std::ostream& os) {
         os.write(reinterpret_cast<const char*>(encoded.data()), static_cast<std::streamsize>(size));
     });
 }

@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/BinaryCursor.hpp"
+#include "BinaryCursor.hpp"
 #include "strata/io/KittiSequence.hpp"
 
 namespace strata::io {

@@ -5,8 +5,8 @@
 #include <string>
 #include <system_error>
 
-#include "io/ScanBuilder.hpp"
-#include "io/TextParsing.hpp"
+#include "ScanBuilder.hpp"
+#include "TextParsing.hpp"
 #include "strata/io/PoseFiles.hpp"
 
 namespace strata::io {

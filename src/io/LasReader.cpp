@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "io/BinaryCursor.hpp"
-#include "io/ScanBuilder.hpp"
+#include "BinaryCursor.hpp"
+#include "ScanBuilder.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {

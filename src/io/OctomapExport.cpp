@@ -12,8 +12,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/AtomicFile.hpp"
-#include "io/ExportInput.hpp"
+#include "strata/io/AtomicFile.hpp"
+#include "ExportInput.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::io {
@@ -82,7 +82,7 @@ void CopyOccupancy(const core::VoxelMap& map, TreeT& tree, OnNode&& on_node) {
 void WriteBinaryTree(const core::VoxelMap& map, const std::filesystem::path& path) {
     octomap::OcTree tree(map.voxel_size);
     CopyOccupancy(map, tree, [](octomap::OcTreeNode*, const openvdb::Coord&, float) {});
-    detail::WriteFileAtomically(path, [&](std::ostream& os) {
+    WriteFileAtomically(path, [&](std::ostream& os) {
         if (!tree.writeBinary(os)) throw std::runtime_error("OctoMap could not serialise the tree");
     });
 }
@@ -97,7 +97,7 @@ void WriteColorTree(const core::VoxelMap& map, const std::filesystem::path& path
                       node->setColor(c.r, c.g, c.b);
                   });
     // AbstractOcTree::write keeps every leaf: no pruning, so no colour averaging.
-    detail::WriteFileAtomically(path, [&](std::ostream& os) {
+    WriteFileAtomically(path, [&](std::ostream& os) {
         if (!tree.write(os)) throw std::runtime_error("OctoMap could not serialise the tree");
     });
 }

@@ -6,10 +6,10 @@
 #include <string_view>
 #include <vector>
 
-#include "io/BinaryCursor.hpp"
-#include "io/PcdHeader.hpp"
-#include "io/ScanBuilder.hpp"
-#include "io/TextParsing.hpp"
+#include "BinaryCursor.hpp"
+#include "PcdHeader.hpp"
+#include "ScanBuilder.hpp"
+#include "TextParsing.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {

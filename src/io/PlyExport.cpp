@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "io/AtomicFile.hpp"
-#include "io/ExportInput.hpp"
+#include "strata/io/AtomicFile.hpp"
+#include "ExportInput.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::io {
@@ -55,7 +55,7 @@ void WritePly(const core::VoxelMap& map, const std::filesystem::path& path) {
     const bool use_double = !map.origin.isZero();
     openvdb::Int32Grid::ConstAccessor labels = map.label->getConstAccessor();
 
-    detail::WriteFileAtomically(path, [&](std::ostream& os) {
+    WriteFileAtomically(path, [&](std::ostream& os) {
         os << Header(map, count, use_double);
         std::vector<char> buffer;
         buffer.reserve(kFlushBytes + 64);

@@ -1,8 +1,8 @@
-#include "io/PlyHeader.hpp"
+#include "PlyHeader.hpp"
 
 #include <stdexcept>
 
-#include "io/TextParsing.hpp"
+#include "TextParsing.hpp"
 
 namespace strata::io::detail {
 namespace {

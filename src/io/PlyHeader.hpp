@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/BinaryCursor.hpp"
+#include "BinaryCursor.hpp"
 
 namespace strata::io::detail {
 

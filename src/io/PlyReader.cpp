@@ -4,10 +4,10 @@
 #include <string_view>
 #include <vector>
 
-#include "io/BinaryCursor.hpp"
-#include "io/PlyHeader.hpp"
-#include "io/ScanBuilder.hpp"
-#include "io/TextParsing.hpp"
+#include "BinaryCursor.hpp"
+#include "PlyHeader.hpp"
+#include "ScanBuilder.hpp"
+#include "TextParsing.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "io/ExportInput.hpp"
+#include "ExportInput.hpp"
 
 namespace strata::io {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "io/TextParsing.hpp"
+#include "TextParsing.hpp"
 
 namespace strata::io {
 namespace {

@@ -1,4 +1,4 @@
-#include "io/ScanBuilder.hpp"
+#include "ScanBuilder.hpp"
 
 #include <utility>
 

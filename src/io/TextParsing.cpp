@@ -1,4 +1,4 @@
-#include "io/TextParsing.hpp"
+#include "TextParsing.hpp"
 
 #include <charconv>
 #include <fstream>

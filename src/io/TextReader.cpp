@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "io/ScanBuilder.hpp"
-#include "io/TextParsing.hpp"
+#include "ScanBuilder.hpp"
+#include "TextParsing.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {

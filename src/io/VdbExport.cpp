@@ -6,8 +6,8 @@
 #include <array>
 #include <string>
 
-#include "io/AtomicFile.hpp"
-#include "io/ExportInput.hpp"
+#include "strata/io/AtomicFile.hpp"
+#include "ExportInput.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::io {
@@ -113,7 +113,7 @@ void WriteGrids(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& file_
                 const std::filesystem::path& path) {
     openvdb::initialize();
     // io::Stream into a checked std::ostream: io::File::write reports success on a full disk.
-    detail::WriteFileAtomically(
+    WriteFileAtomically(
         path, [&](std::ostream& os) { openvdb::io::Stream(os).write(grids, file_meta); });
 }
 

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "registration/CostFunctions.hpp"
+#include "CostFunctions.hpp"
 
 namespace strata::registration {
 

@@ -1,4 +1,4 @@
-#include "store/Catalog.hpp"
+#include "Catalog.hpp"
 
 #include <cinttypes>
 #include <cstdio>

@@ -5,7 +5,7 @@
 #include <map>
 #include <optional>
 
-#include "store/Sqlite.hpp"
+#include "Sqlite.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::store::detail {

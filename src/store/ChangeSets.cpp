@@ -1,6 +1,6 @@
 // Change sets in the catalog: results of change queries, kept so they can be listed later.
-#include "store/Catalog.hpp"
-#include "store/MapStoreImpl.hpp"
+#include "Catalog.hpp"
+#include "MapStoreImpl.hpp"
 
 namespace strata::store {
 

@@ -6,8 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "store/Catalog.hpp"
-#include "store/MapStoreImpl.hpp"
+#include "Catalog.hpp"
+#include "MapStoreImpl.hpp"
 
 namespace strata::store {
 

@@ -16,10 +16,12 @@
 #include <set>
 #include <stdexcept>
 
-#include "store/Catalog.hpp"
-#include "store/MapStoreImpl.hpp"
-#include "store/TileFile.hpp"
-#include "store/TileSplit.hpp"
+#include "strata/core/Error.hpp"
+
+#include "Catalog.hpp"
+#include "MapStoreImpl.hpp"
+#include "TileFile.hpp"
+#include "TileSplit.hpp"
 
 namespace strata::store {
 namespace {
@@ -57,7 +59,7 @@ int TakeWriterLock(const fs::path& dir) {
         ::close(fd);
         std::string holder = n > 0 ? std::string(pid, static_cast<size_t>(n)) : "";
         holder.erase(std::remove(holder.begin(), holder.end(), '\n'), holder.end());
-        throw std::runtime_error(dir.string() + ": another strata process" +
+        throw MapLockedError(dir.string() + ": another strata process" +
                                  (holder.empty() ? "" : " (pid " + holder + ")") +
                                  " is writing this map; one writer at a time, try again when it "
                                  "has finished");
@@ -94,7 +96,7 @@ void RemoveCreationLeftovers(const fs::path& dir) {
 }
 
 void RequireMapDirectory(const fs::path& dir) {
-    if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": no such map directory");
+    if (!fs::is_directory(dir)) throw NotFoundError(dir.string() + ": no such map directory");
     if (fs::exists(dir / kCatalog)) return;
     if (fs::exists(dir / "map.vdb")) {
         throw std::runtime_error(dir.string() +
@@ -239,7 +241,7 @@ MapStore MapStore::Open(const fs::path& dir, Access access) {
     RequireMapDirectory(dir);
     if (access == Access::kWrite) {
         if (!Writable(dir) || !Writable(dir / kCatalog)) {
-            throw std::runtime_error(dir.string() + ": the map is read-only (no write permission)");
+            throw IoError(dir.string() + ": the map is read-only (no write permission)");
         }
         return OpenWithLock(dir, access, TakeWriterLock(dir));
     }

@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "store/Sqlite.hpp"
+#include "Sqlite.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::store {

@@ -5,10 +5,10 @@
 #include <set>
 #include <stdexcept>
 
-#include "store/Catalog.hpp"
-#include "store/MapStoreImpl.hpp"
-#include "store/TileFile.hpp"
-#include "store/TileSplit.hpp"
+#include "Catalog.hpp"
+#include "MapStoreImpl.hpp"
+#include "TileFile.hpp"
+#include "TileSplit.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::store {

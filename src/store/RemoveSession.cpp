@@ -4,9 +4,9 @@
 #include <set>
 #include <stdexcept>
 
-#include "store/Catalog.hpp"
-#include "store/MapStoreImpl.hpp"
-#include "store/TileFile.hpp"
+#include "Catalog.hpp"
+#include "MapStoreImpl.hpp"
+#include "TileFile.hpp"
 #include "strata/integration/IntegrationConfig.hpp"
 #include "strata/store/MapStore.hpp"
 

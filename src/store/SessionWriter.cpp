@@ -9,10 +9,10 @@
 #include <openvdb/tools/Prune.h>
 #include <set>
 
-#include "store/Catalog.hpp"
-#include "store/MapStoreImpl.hpp"
-#include "store/TileFile.hpp"
-#include "store/TileSplit.hpp"
+#include "Catalog.hpp"
+#include "MapStoreImpl.hpp"
+#include "TileFile.hpp"
+#include "TileSplit.hpp"
 #include "strata/core/OccupancyMasks.hpp"
 
 namespace strata::store {

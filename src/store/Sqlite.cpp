@@ -1,4 +1,4 @@
-#include "store/Sqlite.hpp"
+#include "Sqlite.hpp"
 
 #include <sqlite3.h>
 #include <unistd.h>

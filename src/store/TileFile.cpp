@@ -1,4 +1,4 @@
-#include "store/TileFile.hpp"
+#include "TileFile.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/AtomicFile.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 namespace strata::store::detail {
 namespace {
@@ -82,7 +82,7 @@ void WriteTileFile(const fs::path& path, const std::string& bytes) {
         throw std::runtime_error("cannot create '" + path.parent_path().string() +
                                  "': " + ec.message());
     }
-    io::detail::WriteFileAtomically(path, [&](std::ostream& out) {
+    io::WriteFileAtomically(path, [&](std::ostream& out) {
         out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     });
 }

@@ -1,4 +1,4 @@
-#include "store/TileSplit.hpp"
+#include "TileSplit.hpp"
 
 namespace strata::store::detail {
 

@@ -1,9 +1,10 @@
 #include "MapAccess.hpp"
 
 #include <cstdlib>
-#include <fstream>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
+#include "strata/io/AtomicFile.hpp"
 #include "strata/io/VdbExport.hpp"
 
 namespace strata::tools {
@@ -20,7 +21,7 @@ fs::path FindDataDir() {
 
 store::MapStore OpenMap(const fs::path& dir, store::MapStore::Access access) {
     if (!fs::exists(dir)) {
-        throw std::runtime_error(dir.string() + ": no map here (create one with `strata integrate " +
+        throw NotFoundError(dir.string() + ": no map here (create one with `strata integrate " +
                                  dir.string() + " --kitti SEQ`)");
     }
     return store::MapStore::Open(dir, access);
@@ -31,14 +32,7 @@ store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as
 }
 
 void WriteTextFile(const std::string& path, const std::string& text) {
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.flush();
-        if (!out) throw std::runtime_error(path + ": cannot write");
-    }
-    fs::rename(tmp, path);
+    io::WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
 void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path) {

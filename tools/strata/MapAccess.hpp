@@ -21,7 +21,7 @@ namespace strata::tools {
 /// or a name) when given.
 [[nodiscard]] store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of);
 
-/// Writes a text file all at once (temporary file + rename); std::runtime_error naming `path`.
+/// Writes a text file all or nothing (io::WriteFileAtomically: temporary file, fsync, rename).
 void WriteTextFile(const std::string& path, const std::string& text);
 /// Writes grids to a .vdb file.
 void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path);
