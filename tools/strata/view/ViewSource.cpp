@@ -95,6 +95,19 @@ change::ChangeQuery QueryOf(const json& report) {
     return q;
 }
 
+// The session `id_or_name` names (MapStore::FindSession), or NotFoundError listing the sessions.
+int64_t SessionNamed(const store::MapStore& store, const std::string& id_or_name) {
+    std::string known;
+    for (const auto& [session, removed_by] : store.SessionHistory()) {
+        if (std::to_string(session.id) == id_or_name || session.name == id_or_name) {
+            return store.FindSession(id_or_name);
+        }
+        known += (known.empty() ? "" : ", ") + std::to_string(session.id) + " " + session.name;
+    }
+    throw NotFoundError(store.dir().string() + ": no session '" + id_or_name + "' (sessions: " +
+                        (known.empty() ? "none" : known) + ")");
+}
+
 }  // namespace
 
 struct ViewSource::Impl {
@@ -157,7 +170,7 @@ std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::str
                settings.tile_voxels, settings.origin, settings.format_version};
     if (s.facts.name.empty()) s.facts.name = fs::absolute(dir).parent_path().filename().string();
 
-    const int64_t as_of_id = as_of.empty() ? 0 : s.store.FindSession(as_of);
+    const int64_t as_of_id = as_of.empty() ? 0 : SessionNamed(s.store, as_of);
     s.Pin(as_of.empty() ? s.store.Latest() : s.store.AsOf(as_of_id), as_of_id);
     const int64_t commit = s.snapshots.front().commit;
     for (const int64_t id : std::vector<int64_t>(s.snapshots.front().sessions)) {

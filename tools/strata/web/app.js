@@ -91,6 +91,7 @@ strata.Viewer.prototype.pixelScale = function () {
 };
 
 strata.Viewer.prototype.set = function (change) {
+  window.strataViewer.idle = false;  // until the new state is drawn
   Object.assign(this.state, change);
   this.apply();
 };
@@ -108,7 +109,11 @@ strata.Viewer.prototype.colorFunction = function (context) {
   return function (cells, i, out) {
     var f = cells.flags[i];
     if (marked && (f & strata.FLAGS.refilled)) return strata.copy(strata.REFILLED, out);
-    if (context) return strata.copy(strata.CONTEXT, out);
+    if (context) {  // under a diff: the classes faded to grey, so changes stand out
+      var c = (legend[cells.label[i]] || legend[0]).color, g = strata.CONTEXT;
+      for (var k = 0; k < 3; k++) out[k] = Math.round(0.3 * c[k] + 0.7 * g[k]);
+      return out;
+    }
     if (mode === 'height') {
       return strata.ramp((cells.origin[2] + (cells.xyz[3 * i + 2] + 0.5) * cells.cellM - z0) / dz, out);
     }

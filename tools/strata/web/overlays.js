@@ -57,13 +57,12 @@ strata.wallObject = function (wall) {
   return group;
 };
 
-// An upright box turned by yaw about z: edges, and a faint fill that a click can hit.
+// An upright box turned by yaw about z: its edges, and an undrawn fill that a click can hit
+// (a drawn one would tint what is inside, such as the refilled ground under a cleared car).
 function box(center, size, yawDeg, rgb, record) {
   var geometry = new THREE.BoxBufferGeometry(size[0], size[1], size[2]);
   var group = new THREE.Group();
-  var fill = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({
-    color: hex(rgb), transparent: true, opacity: 0.12, depthWrite: false,
-  }));
+  var fill = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ visible: false }));
   fill.userData.record = record;
   group.add(fill);
   group.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry),

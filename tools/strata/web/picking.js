@@ -35,7 +35,9 @@ strata.Viewer.prototype.pickAt = function (clientX, clientY) {
     viewer.sets[name].objects().forEach(function (object) {
       object.traverse(function (o) {
         if (!o.isPoints || !o.visible) return;
-        ray.params.Points.threshold = o.userData.cells.cellM * 0.5;
+        // A cell is drawn as a square of its size facing the camera: a ray through any of its
+        // pixels passes within half a diagonal of its centre.
+        ray.params.Points.threshold = o.userData.cells.cellM * 0.75;
         var hit = ray.intersectObject(o, false)[0];
         if (hit && (!best || hit.distance < best.distance - 1e-6)) best = hit;
       });
@@ -45,6 +47,7 @@ strata.Viewer.prototype.pickAt = function (clientX, clientY) {
   var record = shape && (!best || shape.distance <= best.distance + 1.0)
     ? shape.object.userData.record : best ? this.cellRecord(best.object, best.index) : null;
   window.strataViewer.lastRecord = record;
+  window.strataViewer.picks = (window.strataViewer.picks || 0) + 1;
   if (record) this.ui.showRecord(record);
   if (record && record.kind === 'voxel' && !strata.isStatic()) this.voxelRecord(record);
   return record;
