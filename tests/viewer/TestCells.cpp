@@ -128,7 +128,8 @@ TEST(Cells, CellsCarryFirstSessionSlantWallRefillAndClearedVehicles) {
 TEST(Cells, AFreeSliceHoldsOnlyFreeVoxelsOfItsHeights) {
     const TileGrids floor = Floor(8);
     for (int k = 1; k <= 6; ++k) Mutable(floor)->tree().setValue(Coord(2, 2, k), -0.4F);
-    const Cells slice = FreeCells(*floor.occupancy, CoordBBox(Coord(-50, -50, 2), Coord(50, 50, 3)), 0);
+    const Cells slice =
+        FreeCells(*floor.occupancy, CoordBBox(Coord(-50, -50, 2), Coord(50, 50, 3)), 0);
     ASSERT_EQ(slice.size(), 2u);
     for (size_t i = 0; i < slice.size(); ++i) EXPECT_EQ(slice.flags[i], cell_flags::kFree);
 }

@@ -17,7 +17,8 @@ namespace strata::view::test {
 namespace {
 
 // The status code of the answer to `request` (sent as is), 0 when the connection failed.
-int Status(int port, const std::string& request, std::string* body = nullptr) {
+int Status(int port, const std::string& request, std::string* body = nullptr,
+           std::string* head = nullptr) {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in address{};
     address.sin_family = AF_INET;
@@ -38,21 +39,23 @@ int Status(int port, const std::string& request, std::string* body = nullptr) {
     char buffer[65536];
     for (ssize_t n; (n = ::recv(fd, buffer, sizeof(buffer), 0)) > 0;) {
         answer.append(buffer, static_cast<size_t>(n));
-        const size_t head = answer.find("\r\n\r\n");
+        const size_t blank = answer.find("\r\n\r\n");
         const size_t length = answer.find("Content-Length: ");
-        if (head != std::string::npos && length != std::string::npos && length < head &&
-            answer.size() >= head + 4 + std::stoul(answer.substr(length + 16))) {
+        if (blank != std::string::npos && length != std::string::npos && length < blank &&
+            answer.size() >= blank + 4 + std::stoul(answer.substr(length + 16))) {
             break;
         }
     }
     ::close(fd);
-    if (body) *body = answer.substr(std::min(answer.size(), answer.find("\r\n\r\n") + 4));
+    const size_t end_of_head = std::min(answer.size(), answer.find("\r\n\r\n") + 4);
+    if (body) *body = answer.substr(end_of_head);
+    if (head) *head = answer.substr(0, end_of_head);
     return answer.rfind("HTTP/1.1 ", 0) == 0 ? std::stoi(answer.substr(9, 3)) : 0;
 }
 
 std::string Get(const std::string& target, int port, const std::string& host = "") {
-    return "GET " + target + " HTTP/1.1\r\nHost: " +
-           (host.empty() ? "127.0.0.1:" + std::to_string(port) : host) +
+    return "GET " + target +
+           " HTTP/1.1\r\nHost: " + (host.empty() ? "127.0.0.1:" + std::to_string(port) : host) +
            "\r\nConnection: close\r\n\r\n";
 }
 
@@ -86,9 +89,24 @@ TEST_F(HttpServerTest, ServesThePageAndTheManifestOnLoopback) {
     EXPECT_EQ(Status(port(), Get("/api/map", port()), &body), 200);
     EXPECT_NE(body.find("\"snapshots\""), std::string::npos);
     EXPECT_EQ(Status(port(), Get("/api/map", port(), "localhost:" + std::to_string(port()))), 200);
-    EXPECT_EQ(Status(port(), "HEAD /app.js HTTP/1.1\r\nHost: 127.0.0.1:" +
-                                 std::to_string(port()) + "\r\nConnection: close\r\n\r\n"),
+    EXPECT_EQ(Status(port(), "HEAD /app.js HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port()) +
+                                 "\r\nConnection: close\r\n\r\n"),
               200);
+}
+
+TEST_F(HttpServerTest, ScriptsGoOutUncompressed) {
+    // cpp-httplib would brotli-compress text/* at its slowest setting on every request.
+    for (const std::string target : {"/three.min.js", "/app.js", "/api/map", "/"}) {
+        const std::string request = "GET " + target +
+                                    " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port()) +
+                                    "\r\nAccept-Encoding: gzip, deflate, br\r\n"
+                                    "Connection: close\r\n\r\n";
+        std::string head;
+        EXPECT_EQ(Status(port(), request, nullptr, &head), 200) << target;
+        if (target != "/") {
+            EXPECT_EQ(head.find("Content-Encoding"), std::string::npos) << target << head;
+        }
+    }
 }
 
 TEST_F(HttpServerTest, TraversalAttemptsGetA404AndTheServerKeepsServing) {
@@ -114,9 +132,9 @@ TEST_F(HttpServerTest, TraversalAttemptsGetA404AndTheServerKeepsServing) {
 TEST_F(HttpServerTest, OnlyGetAndHeadAreAnsweredAndTheMapIsNotTouched) {
     const auto before = std::filesystem::last_write_time(map_->dir / "catalog.sqlite");
     for (const std::string method : {"POST", "PUT", "DELETE", "PATCH", "OPTIONS"}) {
-        const std::string request = method + " /api/map HTTP/1.1\r\nHost: 127.0.0.1:" +
-                                    std::to_string(port()) +
-                                    "\r\nContent-Length: 2\r\nConnection: close\r\n\r\n{}";
+        const std::string request =
+            method + " /api/map HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port()) +
+            "\r\nContent-Length: 2\r\nConnection: close\r\n\r\n{}";
         EXPECT_EQ(Status(port(), request), 405) << method;
     }
     EXPECT_EQ(std::filesystem::last_write_time(map_->dir / "catalog.sqlite"), before);

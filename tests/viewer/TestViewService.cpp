@@ -33,8 +33,8 @@ json Get(const ViewService& service, const std::string& path) {
 
 TEST(ViewService, ServesThePageThreeJsAndAManifestOfEveryPinnedSnapshot) {
     const auto service = Service(Map().dir);
-    for (const std::string path : {"/", "/index.html", "/app.js", "/style.css", "/three.min.js",
-                                   "/OrbitControls.js"}) {
+    for (const std::string path :
+         {"/", "/index.html", "/app.js", "/style.css", "/three.min.js", "/OrbitControls.js"}) {
         const Response r = service->Get(path);
         EXPECT_EQ(r.status, 200) << path;
         EXPECT_GT(r.body.size(), 100u) << path;
@@ -101,16 +101,16 @@ TEST(ViewService, OnlyItsOwnRoutesAnswerAndNoPathReachesAFile) {
          {"/catalog.sqlite", "/../catalog.sqlite", "/api/../catalog.sqlite", "/tiles/0_0/v1.vdb",
           "/api/tile/0/0/1/../../../catalog.sqlite", "/etc/passwd", "//etc/passwd",
           "/api/map/../../etc/passwd", "/%2e%2e/catalog.sqlite", "/api/tile/0/0/1",
-          "/api/tile/0/0/1/0/", "/api/tile/a/0/1/0", "/index.html/", "/api/voxel/1/2/3",
-          "", "/api/changeset/x", "/app.js?x=1", "/APP.JS"}) {
+          "/api/tile/0/0/1/0/", "/api/tile/a/0/1/0", "/index.html/", "/api/voxel/1/2/3", "",
+          "/api/changeset/x", "/app.js?x=1", "/APP.JS"}) {
         const Response r = service->Get(path);
         EXPECT_EQ(r.status, 404) << path;
         EXPECT_EQ(r.body.find("SQLite"), std::string::npos) << path;
     }
     EXPECT_EQ(service->Get("/" + std::string(300, 'a')).status, 414);
     EXPECT_EQ(service->Get("/api/tile/0/0/1/9").status, 400);                     // no such level
-    EXPECT_EQ(service->Get("/api/tile/99999999999/0/1/0").status, 404);          // no such tile
-    EXPECT_EQ(service->Get("/api/tile/0/0/999999/0").status, 404);              // no such version
+    EXPECT_EQ(service->Get("/api/tile/99999999999/0/1/0").status, 404);           // no such tile
+    EXPECT_EQ(service->Get("/api/tile/0/0/999999/0").status, 404);                // no such version
     EXPECT_EQ(service->Get("/api/tile/0/0/99999999999999999999/0").status, 404);  // > 19 digits
     EXPECT_EQ(service->Get("/api/diff/1/1").status, 400);
     EXPECT_EQ(service->Get("/api/diff/1/9").status, 404);
@@ -121,8 +121,9 @@ TEST(ViewService, ADiffBetweenSessionsIsWhatStrataDiffReportsAndHoldsTheCrate) {
     const auto service = Service(Map().dir);
     const json diff = Get(*service, "/api/diff/1/2");
     const json saved = Get(*service, "/api/map")["change_sets"][0];
-    EXPECT_EQ(diff["report"]["added_voxels"], saved["added_voxels"]);
-    EXPECT_EQ(diff["report"]["removed_voxels"], saved["removed_voxels"]);
+    EXPECT_EQ(diff["report"]["added_voxels"], saved["report"]["added_voxels"]);
+    EXPECT_EQ(diff["report"]["removed_voxels"], saved["report"]["removed_voxels"]);
+    EXPECT_EQ(diff["report"]["objects"], saved["report"]["objects"]);
     ASSERT_TRUE(diff["voxels"].get<bool>());
     size_t added = 0, in_crate = 0;
     for (const json& xy : diff["tiles"]) {
@@ -142,8 +143,8 @@ TEST(ViewService, ADiffBetweenSessionsIsWhatStrataDiffReportsAndHoldsTheCrate) {
         }
     }
     EXPECT_EQ(added, diff["report"]["added_voxels"].get<size_t>());
-    EXPECT_GT(added, 50u);             // the crate's visible faces, at least
-    EXPECT_EQ(in_crate, added);        // and nothing else
+    EXPECT_GT(added, 50u);       // the crate's visible faces, at least
+    EXPECT_EQ(in_crate, added);  // and nothing else
 }
 
 TEST(ViewService, ASavedChangeSetIsRebuiltWhenItsSidesAreSessionsAndOnlyThen) {
@@ -166,16 +167,18 @@ TEST(ViewService, AVoxelRecordHoldsEveryValueAndTheWallRowItBelongsTo) {
     // A cell the tile answer marks as part of the north wall, at level 0: one voxel.
     size_t checked = 0;
     for (const json& t : m["snapshots"][0]["tiles"]) {
-        const Cells cells = DecodeCells(
-            service->Get("/api/tile/" + std::to_string(t["x"].get<int>()) + "/" +
-                         std::to_string(t["y"].get<int>()) + "/" +
-                         std::to_string(t["version"].get<int64_t>()) + "/0").body);
+        const Cells cells =
+            DecodeCells(service
+                            ->Get("/api/tile/" + std::to_string(t["x"].get<int>()) + "/" +
+                                  std::to_string(t["y"].get<int>()) + "/" +
+                                  std::to_string(t["version"].get<int64_t>()) + "/0")
+                            .body);
         for (size_t i = 0; i < cells.size() && checked < 3; ++i) {
             if (!(cells.flags[i] & cell_flags::kWall)) continue;
             const openvdb::Coord c = cells.cell[i];
-            const json v = Get(*service, "/api/voxel/" + std::to_string(commit) + "/" +
-                                             std::to_string(c.x()) + "/" + std::to_string(c.y()) +
-                                             "/" + std::to_string(c.z()));
+            const json v =
+                Get(*service, "/api/voxel/" + std::to_string(commit) + "/" + std::to_string(c.x()) +
+                                  "/" + std::to_string(c.y()) + "/" + std::to_string(c.z()));
             EXPECT_EQ(v["kind"], "voxel");
             ASSERT_TRUE(v["observed"].get<bool>()) << v.dump();
             EXPECT_TRUE(v["occupied"].get<bool>());
@@ -220,8 +223,8 @@ TEST(ViewService, KeepsServingItsSnapshotWhileTheMapMovesOn) {
         const std::string path = "/api/tile/" + std::to_string(t["x"].get<int>()) + "/" +
                                  std::to_string(t["y"].get<int>()) + "/" +
                                  std::to_string(t["version"].get<int64_t>()) + "/0";
-        const bool pinned = std::any_of(tiles.begin(), tiles.end(),
-                                        [&](const auto& p) { return p.first == path; });
+        const bool pinned =
+            std::any_of(tiles.begin(), tiles.end(), [&](const auto& p) { return p.first == path; });
         if (!pinned) {
             EXPECT_EQ(service->Get(path).status, 404) << path;
         }

@@ -22,7 +22,7 @@ namespace strata::view::test {
 namespace fs = std::filesystem;
 
 inline constexpr double kVoxel = 0.1;
-inline constexpr double kTile = 6.4;  // 64 voxels: the room spans several tiles
+inline constexpr double kTile = 6.4;                     // 64 voxels: the room spans several tiles
 inline const Eigen::Vector3d kCrateMin(2.0, 1.0, -1.5);  // the crate stands on the floor
 inline constexpr double kCrateEdge = 1.0;
 inline constexpr double kNorthWallY = 4.0;

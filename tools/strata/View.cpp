@@ -43,8 +43,8 @@ void Run(const ViewArgs& args) {
     view::HttpServer server(service, args.serve);
     std::cout << "strata view: " << args.map << " (commit " << shown.commit << ", "
               << shown.tiles.size() << " tiles, " << shown.sessions.size()
-              << " sessions), read-only, at\n  " << Address(args.serve.bind, server.port())
-              << "\nCtrl-C stops.\n"
+              << (shown.sessions.size() == 1 ? " session" : " sessions") << "), read-only, at\n  "
+              << Address(args.serve.bind, server.port()) << "\nCtrl-C stops.\n"
               << std::flush;
     if (args.serve.bind != "127.0.0.1" && args.serve.bind != "localhost" &&
         args.serve.bind != "::1") {
@@ -59,8 +59,9 @@ void Run(const ViewArgs& args) {
 void RegisterView(CLI::App& app) {
     auto args = std::make_shared<ViewArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "view", "Look at the map in a browser: voxels by class, height, session or slant; walls, "
-                "vehicles, changes; a session timeline");
+        "view",
+        "Look at the map in a browser: voxels by class, height, session or slant; walls, "
+        "vehicles, changes; a session timeline");
     cmd->footer(
         "Examples:\n"
         "  strata view strata-demo/map                 # then open the address it prints\n"

@@ -87,7 +87,8 @@ Cells DecodeCells(const std::string& bytes) {
         for (int axis = 0; axis < 3; ++axis) c[axis] = origin[axis] + Get<int16_t>(bytes, at);
         cells.cell.push_back(c);
     }
-    for (std::vector<uint8_t>* column : {&cells.label, &cells.session, &cells.slant, &cells.flags}) {
+    for (std::vector<uint8_t>* column :
+         {&cells.label, &cells.session, &cells.slant, &cells.flags}) {
         column->assign(bytes.begin() + static_cast<std::ptrdiff_t>(at),
                        bytes.begin() + static_cast<std::ptrdiff_t>(at + count));
         at += count;

@@ -2,7 +2,7 @@
 // Private to view: the attributes of one voxel and how the voxels of one leaf merge into cells.
 
 #include <array>
-#include <optional>
+#include <utility>
 #include <vector>
 
 #include "Cells.hpp"
@@ -22,18 +22,27 @@ struct Voxel {
 /// A class value as one byte: values outside the taxonomy become unknown (0).
 [[nodiscard]] uint8_t ClassByte(int32_t label);
 
-/// Reads a voxel's attributes from a tile's grids (one accessor each; not thread-safe).
+/// Reads voxels' attributes from a tile's grids, leaf by leaf: the leaves of every grid at one
+/// origin are looked up once (grids of a map share their leaf layout), then each voxel is read by
+/// its offset in the leaf. Not thread-safe.
 class VoxelAttributes {
 public:
     explicit VoxelAttributes(const TileGrids& tile);
-    [[nodiscard]] Voxel Of(const openvdb::Coord& ijk);
+    /// Looks up the leaves at `origin` (a multiple of 8) for the calls to Of that follow.
+    void Leaf(const openvdb::Coord& origin);
+    /// The attributes of the voxel at `offset` (0..511) in the current leaf.
+    [[nodiscard]] Voxel Of(openvdb::Index offset) const;
 
 private:
-    std::optional<openvdb::Int32Grid::ConstAccessor> label_;
-    std::vector<std::pair<int64_t, openvdb::BoolGrid::ConstAccessor>> sessions_;
-    std::optional<openvdb::FloatGrid::ConstAccessor> slant_;
-    std::optional<openvdb::Int32Grid::ConstAccessor> wall_id_;
-    std::optional<openvdb::FloatGrid::ConstAccessor> refilled_;
+    using FloatLeaf = openvdb::FloatGrid::TreeType::LeafNodeType;
+    using IntLeaf = openvdb::Int32Grid::TreeType::LeafNodeType;
+    using BoolLeaf = openvdb::BoolGrid::TreeType::LeafNodeType;
+    const TileGrids& tile_;
+    const IntLeaf* label_ = nullptr;
+    std::vector<std::pair<int64_t, const BoolLeaf*>> sessions_;
+    const FloatLeaf* slant_ = nullptr;
+    const IntLeaf* wall_id_ = nullptr;
+    const FloatLeaf* refilled_ = nullptr;
 };
 
 /// Merges the voxels of one leaf into cells of 2^lod voxels (a cell never spans two leaves for

@@ -35,8 +35,8 @@ struct TileGrids {
     std::vector<std::pair<int64_t, openvdb::BoolGrid::ConstPtr>> sessions;
     openvdb::FloatGrid::ConstPtr slant_deg;  ///< walls' products
     openvdb::Int32Grid::ConstPtr wall_id;
-    openvdb::Int32Grid::ConstPtr cleared;    ///< vehicle id of each removed voxel
-    openvdb::FloatGrid::ConstPtr refilled;   ///< refilled ground voxels
+    openvdb::Int32Grid::ConstPtr cleared;   ///< vehicle id of each removed voxel
+    openvdb::FloatGrid::ConstPtr refilled;  ///< refilled ground voxels
     // For a voxel's record only:
     openvdb::Int32Grid::ConstPtr hits;
     std::vector<std::pair<int64_t, openvdb::BoolGrid::ConstPtr>> sessions_free;
@@ -63,15 +63,19 @@ struct Cells {
     [[nodiscard]] size_t size() const { return cell.size(); }
 };
 
-/// Occupied voxels of `tiles` inside `bounds` (voxel index box), merged by 2^lod, followed by
-/// the cleared vehicle voxels (flag kCleared) merged alike. Cells come in leaf order.
+/// Occupied voxels of `tile` inside `bounds` (voxel index box), merged by 2^lod, followed by
+/// the cleared vehicle voxels (flag kCleared) merged alike. Cells come leaf by leaf. Coarser
+/// levels are CoarsenCells of level 0 (a coarse cell's slant is the mean of its voxels' slants
+/// to half a degree).
 /// @throw InvalidArgumentError when lod is outside [0, kMaxLod] or occupancy is null.
-[[nodiscard]] Cells OccupiedCells(const TileGrids& tile, const openvdb::CoordBBox& bounds,
-                                  int lod);
+[[nodiscard]] Cells OccupiedCells(const TileGrids& tile, const openvdb::CoordBBox& bounds, int lod);
+/// Level-0 cells merged by 2^lod: what OccupiedCells gives at `lod`, without the pass over the
+/// tile's grids (the costly step, every active voxel).
+[[nodiscard]] Cells CoarsenCells(const Cells& fine, int lod);
 /// Observed free voxels inside `bounds` (flag kFree), merged by 2^lod: a slice when the box is
 /// thin in z.
-[[nodiscard]] Cells FreeCells(const openvdb::FloatGrid& occupancy,
-                              const openvdb::CoordBBox& bounds, int lod);
+[[nodiscard]] Cells FreeCells(const openvdb::FloatGrid& occupancy, const openvdb::CoordBBox& bounds,
+                              int lod);
 /// Added voxels (flag kAdded) then removed ones (kRemoved) inside `bounds`, merged by 2^lod.
 [[nodiscard]] Cells ChangeCells(const ChangeVoxels& change, const openvdb::CoordBBox& bounds,
                                 int lod);

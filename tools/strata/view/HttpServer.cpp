@@ -70,10 +70,9 @@ HttpServer::HttpServer(std::shared_ptr<const ViewService> service, const ServeOp
         res.status = answer.status;
         res.set_content(std::move(answer.body), answer.content_type.c_str());
     });
-    impl_->port = options.port == 0 ? server.bind_to_any_port(options.bind)
-                                    : (server.bind_to_port(options.bind, options.port)
-                                           ? options.port
-                                           : -1);
+    impl_->port = options.port == 0
+                      ? server.bind_to_any_port(options.bind)
+                      : (server.bind_to_port(options.bind, options.port) ? options.port : -1);
     if (impl_->port <= 0) {
         throw IoError("cannot listen on " + options.bind + ":" + std::to_string(options.port) +
                       " (in use, or not an address of this machine)");

@@ -36,6 +36,7 @@ ViewService::Impl::Impl(std::shared_ptr<const ViewSource> source_in,
     : source(std::move(source_in)),
       assets(std::move(assets_in)),
       tiles(options.tile_cache_bytes),
+      fine(options.cell_cache_bytes),
       responses(options.response_cache_bytes),
       changes(options.change_cache_bytes) {}
 
@@ -54,23 +55,31 @@ std::shared_ptr<const TileGrids> ViewService::Impl::Tile(const TileRef& ref) {
     return grids;
 }
 
+std::shared_ptr<const Cells> ViewService::Impl::Fine(const TileRef& ref) {
+    if (auto cached = fine.Get(ref)) return cached;
+    auto cells = std::make_shared<const Cells>(OccupiedCells(*Tile(ref), TileBox(ref.x, ref.y), 0));
+    fine.Put(ref, cells, cells->size() * 20 + 256);
+    return cells;
+}
+
 openvdb::CoordBBox ViewService::Impl::TileBox(int32_t x, int32_t y) const {
     const int32_t n = source->facts().tile_voxels;
     constexpr int32_t kLow = std::numeric_limits<int32_t>::min() / 2;  // all of z
     constexpr int32_t kHigh = std::numeric_limits<int32_t>::max() / 2;
-    return {openvdb::Coord(x * n, y * n, kLow), openvdb::Coord((x + 1) * n - 1, (y + 1) * n - 1, kHigh)};
+    return {openvdb::Coord(x * n, y * n, kLow),
+            openvdb::Coord((x + 1) * n - 1, (y + 1) * n - 1, kHigh)};
 }
 
 TileStats ViewService::Impl::Stats(const TileRef& ref) {
-    const auto grids = Tile(ref);
-    TileStats stats{ref, {}, {}, 0};
+    const auto cells = Fine(ref);
+    TileStats stats{ref, {}, {}, 0, 0};
     openvdb::CoordBBox box;
-    for (auto v = grids->occupancy->cbeginValueOn(); v; ++v) {
-        if (*v <= 0.0F) continue;
-        v.isVoxelValue() ? box.expand(v.getCoord()) : box.expand(v.getBoundingBox());
-        stats.voxels += v.getVoxelCount();
+    for (size_t i = 0; i < cells->size(); ++i) {
+        box.expand(cells->cell[i]);
+        const bool occupied = (cells->flags[i] & cell_flags::kCleared) == 0;
+        stats.voxels += occupied;
+        stats.labelled_voxels += occupied && cells->label[i] != 0;
     }
-    if (grids->cleared) box.expand(grids->cleared->evalActiveVoxelBoundingBox());
     const double s = source->facts().voxel_size_m;
     if (box.empty()) {
         const openvdb::Coord corner = TileBox(ref.x, ref.y).min();
@@ -83,8 +92,9 @@ TileStats ViewService::Impl::Stats(const TileRef& ref) {
 }
 
 const TileStats& ViewService::Impl::StatsOf(const TileRef& ref) const {
-    const auto it = std::lower_bound(stats.begin(), stats.end(), ref,
-                                     [](const TileStats& s, const TileRef& r) { return s.tile < r; });
+    const auto it =
+        std::lower_bound(stats.begin(), stats.end(), ref,
+                         [](const TileStats& s, const TileRef& r) { return s.tile < r; });
     if (it == stats.end() || !(it->tile == ref)) throw NotFoundError("tile not in this view");
     return *it;
 }
@@ -97,9 +107,9 @@ Response ViewService::Impl::Cached(const std::string& path, const std::function<
 }
 
 Response ViewService::Impl::TileCells(const TileRef& ref, int lod) {
-    const auto grids = Tile(ref);
-    return Binary(EncodeCells(OccupiedCells(*grids, TileBox(ref.x, ref.y), lod),
-                              source->facts().voxel_size_m));
+    const auto cells = Fine(ref);
+    const double voxel = source->facts().voxel_size_m;
+    return Binary(EncodeCells(lod == 0 ? *cells : CoarsenCells(*cells, lod), voxel));
 }
 
 Response ViewService::Impl::FreeSlice(const TileRef& ref, int lod, int32_t slab) {
@@ -109,7 +119,8 @@ Response ViewService::Impl::FreeSlice(const TileRef& ref, int lod, int32_t slab)
     if (k0 < box.min().z() || k0 > box.max().z()) throw InvalidArgumentError("slice out of range");
     box.min().z() = static_cast<int32_t>(k0);
     box.max().z() = static_cast<int32_t>(k0 + (1 << lod) - 1);
-    return Binary(EncodeCells(FreeCells(*grids->occupancy, box, lod), source->facts().voxel_size_m));
+    return Binary(
+        EncodeCells(FreeCells(*grids->occupancy, box, lod), source->facts().voxel_size_m));
 }
 
 std::shared_ptr<const ChangeEntry> ViewService::Impl::Change(const std::string& key) {
@@ -126,8 +137,8 @@ std::shared_ptr<const ChangeEntry> ViewService::Impl::Change(const std::string& 
     } else if (std::sscanf(key.c_str(), "changeset/%ld", &a) == 1) {
         entry->masks = source->ChangeSetVoxels(a);
         const json& sets = source->change_sets();
-        const auto it = std::find_if(sets.begin(), sets.end(),
-                                     [&](const json& s) { return s.at("id") == a; });
+        const auto it =
+            std::find_if(sets.begin(), sets.end(), [&](const json& s) { return s.at("id") == a; });
         entry->summary = {{"id", a}, {"record", it != sets.end() ? *it : json()}};
     }
     size_t bytes = 1024;

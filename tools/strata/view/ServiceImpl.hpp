@@ -14,7 +14,7 @@ namespace strata::view {
 
 /// A session diff or a saved change set, computed once and kept in a cache.
 struct ChangeEntry {
-    std::optional<ChangeMasks> masks;  ///< empty: the voxels cannot be rebuilt
+    std::optional<ChangeMasks> masks;                ///< empty: the voxels cannot be rebuilt
     std::vector<std::pair<int32_t, int32_t>> tiles;  ///< tiles holding changed voxels
     nlohmann::json summary;
 };
@@ -28,6 +28,8 @@ struct ViewService::Impl {
 
     /// A tile's grids, from the cache or read and verified.
     [[nodiscard]] std::shared_ptr<const TileGrids> Tile(const TileRef& ref);
+    /// A tile's level-0 cells (its occupied and cleared voxels), from the cache or made.
+    [[nodiscard]] std::shared_ptr<const Cells> Fine(const TileRef& ref);
     [[nodiscard]] TileStats Stats(const TileRef& ref);
     [[nodiscard]] const TileStats& StatsOf(const TileRef& ref) const;
     /// Voxel bounds of tile (x, y): its columns, all of z.
@@ -46,6 +48,7 @@ struct ViewService::Impl {
     std::vector<WebAsset> assets;
     std::vector<TileStats> stats;  ///< sorted by tile
     detail::LruCache<TileRef, TileGrids> tiles;
+    detail::LruCache<TileRef, Cells> fine;
     detail::LruCache<std::string, Response> responses;
     detail::LruCache<std::string, ChangeEntry> changes;
     std::mutex computing;  ///< one change query at a time (each reads many tiles)

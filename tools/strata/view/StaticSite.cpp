@@ -87,26 +87,30 @@ StaticSiteReport WriteStaticSite(const ViewService& service, const fs::path& dir
     try {
         std::vector<std::pair<int64_t, int64_t>> diffs;
         const std::vector<int64_t>& sessions = service.source().snapshots().front().sessions;
-        for (size_t i = 1; i < sessions.size(); ++i) diffs.emplace_back(sessions[i - 1], sessions[i]);
+        for (size_t i = 1; i < sessions.size(); ++i)
+            diffs.emplace_back(sessions[i - 1], sessions[i]);
         for (const WebAsset& a : service.assets()) {
             std::string body = a.body;
             if (a.name == "index.html") {
                 const size_t at = body.find(kStaticMarker);
-                if (at == std::string::npos) throw FormatError("index.html lacks its static marker");
+                if (at == std::string::npos)
+                    throw FormatError("index.html lacks its static marker");
                 body.replace(at, kStaticMarker.size(), "<script src=\"data/api_map.js\"></script>");
             }
             site.Write(a.name, body);
         }
-        site.Write("data/api_map.js", "strataPayload(\"/api/map\"," +
-                                          service.Manifest(true, diffs).dump() + ");\n");
+        site.Write("data/api_map.js",
+                   "strataPayload(\"/api/map\"," + service.Manifest(true, diffs).dump() + ");\n");
         for (const TileStats& t : service.tile_stats()) {
             for (int lod = 0; lod <= kMaxLod; ++lod) {
-                site.Payload("/api/tile/" + std::to_string(t.tile.x) + "/" + std::to_string(t.tile.y) +
-                             "/" + std::to_string(t.tile.version) + "/" + std::to_string(lod));
+                site.Payload("/api/tile/" + std::to_string(t.tile.x) + "/" +
+                             std::to_string(t.tile.y) + "/" + std::to_string(t.tile.version) + "/" +
+                             std::to_string(lod));
             }
         }
         std::vector<std::string> changes;
-        for (const auto& [a, b] : diffs) changes.push_back("diff/" + std::to_string(a) + "/" + std::to_string(b));
+        for (const auto& [a, b] : diffs)
+            changes.push_back("diff/" + std::to_string(a) + "/" + std::to_string(b));
         for (const nlohmann::json& set : service.source().change_sets()) {
             changes.push_back("changeset/" + std::to_string(set.at("id").get<int64_t>()));
         }

@@ -15,7 +15,8 @@ namespace {
 using nlohmann::json;
 
 Response Json(const json& body, int status = 200) {
-    return {status, "application/json; charset=utf-8", body.dump()};  // not compressed: see WebAssets
+    return {status, "application/json; charset=utf-8",
+            body.dump()};  // not compressed: see WebAssets
 }
 
 Response Error(int status, const std::string& what) { return Json({{"error", what}}, status); }
@@ -25,7 +26,8 @@ int64_t Number(const std::ssub_match& text, int64_t lo, int64_t hi) {
     const std::string s = text.str();
     if (s.size() > 19) throw InvalidArgumentError("number out of range in the request path");
     const long long value = std::stoll(s);
-    if (value < lo || value > hi) throw InvalidArgumentError("number out of range in the request path");
+    if (value < lo || value > hi)
+        throw InvalidArgumentError("number out of range in the request path");
     return value;
 }
 
@@ -38,7 +40,8 @@ ViewService::ViewService(std::shared_ptr<const ViewSource> source, std::vector<W
                          ServiceOptions options)
     : impl_(std::make_unique<Impl>(std::move(source), std::move(assets), options)) {
     std::set<TileRef> unique;
-    for (const ViewSnapshot& s : impl_->source->snapshots()) unique.insert(s.tiles.begin(), s.tiles.end());
+    for (const ViewSnapshot& s : impl_->source->snapshots())
+        unique.insert(s.tiles.begin(), s.tiles.end());
     std::vector<TileRef> tiles(unique.begin(), unique.end());
     impl_->stats.resize(tiles.size());
     tbb::parallel_for(size_t{0}, tiles.size(),
@@ -69,6 +72,7 @@ json ViewService::Manifest(bool static_site,
                              {"y", t.y},
                              {"version", t.version},
                              {"voxels", st.voxels},
+                             {"labelled_voxels", st.labelled_voxels},
                              {"min", {st.min.x(), st.min.y(), st.min.z()}},
                              {"max", {st.max.x(), st.max.y(), st.max.z()}}});
         }
@@ -104,10 +108,13 @@ Response ViewService::Get(const std::string& path) const {
     static const std::regex free(
         R"(/api/free/(-?\d{1,10})/(-?\d{1,10})/(\d{1,19})/(\d)/(-?\d{1,10}))");
     static const std::regex diff(R"(/api/diff/(\d{1,19})/(\d{1,19}))");
-    static const std::regex diff_cells(R"(/api/diff/(\d{1,19})/(\d{1,19})/(-?\d{1,10})/(-?\d{1,10})/(\d))");
+    static const std::regex diff_cells(
+        R"(/api/diff/(\d{1,19})/(\d{1,19})/(-?\d{1,10})/(-?\d{1,10})/(\d))");
     static const std::regex change(R"(/api/changeset/(\d{1,19}))");
-    static const std::regex change_cells(R"(/api/changeset/(\d{1,19})/(-?\d{1,10})/(-?\d{1,10})/(\d))");
-    static const std::regex voxel(R"(/api/voxel/(\d{1,19})/(-?\d{1,10})/(-?\d{1,10})/(-?\d{1,10}))");
+    static const std::regex change_cells(
+        R"(/api/changeset/(\d{1,19})/(-?\d{1,10})/(-?\d{1,10})/(\d))");
+    static const std::regex voxel(
+        R"(/api/voxel/(\d{1,19})/(-?\d{1,10})/(-?\d{1,10})/(-?\d{1,10}))");
     try {
         if (path.size() > 256) return Error(414, "path too long");
         for (const WebAsset& a : impl_->assets) {

@@ -21,6 +21,7 @@ struct Response {
 
 struct ServiceOptions {
     size_t tile_cache_bytes = size_t{512} << 20;      ///< decoded tiles kept in memory
+    size_t cell_cache_bytes = size_t{256} << 20;      ///< each tile's level-0 cells
     size_t response_cache_bytes = size_t{256} << 20;  ///< encoded answers kept
     size_t change_cache_bytes = size_t{256} << 20;    ///< session diffs and change sets kept
 };
@@ -32,6 +33,7 @@ struct TileStats {
     Eigen::Vector3d min = Eigen::Vector3d::Zero();
     Eigen::Vector3d max = Eigen::Vector3d::Zero();
     size_t voxels = 0;
+    size_t labelled_voxels = 0;  ///< of a class other than unknown
 };
 
 /// Answers GET requests for a fixed set of routes (docs/viewer.md, "Routes"): the page's own
@@ -57,7 +59,8 @@ public:
     [[nodiscard]] const std::vector<WebAsset>& assets() const;
     /// Tiles holding changed voxels of a diff ("diff/A/B") or change set ("changeset/ID"), for
     /// the static export; empty when the change set's voxels cannot be rebuilt.
-    [[nodiscard]] std::vector<std::pair<int32_t, int32_t>> ChangeTiles(const std::string& key) const;
+    [[nodiscard]] std::vector<std::pair<int32_t, int32_t>> ChangeTiles(
+        const std::string& key) const;
 
 private:
     struct Impl;

@@ -27,40 +27,46 @@ json SessionJson(const store::SessionRecord& s, int64_t removed_by) {
     for (int r = 0; r < 4; ++r) {
         for (int c = 0; c < 4; ++c) alignment.push_back(s.alignment(r, c));
     }
-    return {{"id", s.id},         {"name", s.name},         {"source", s.source},
+    return {{"id", s.id},         {"name", s.name},           {"source", s.source},
             {"sensor", s.sensor}, {"start_utc", s.start_utc}, {"end_utc", s.end_utc},
-            {"scans", s.scans},   {"points", s.points},     {"alignment", alignment},
-            {"notes", s.notes},   {"commit", s.commit},     {"removed_by_commit", removed_by}};
+            {"scans", s.scans},   {"points", s.points},       {"alignment", alignment},
+            {"notes", s.notes},   {"commit", s.commit},       {"removed_by_commit", removed_by}};
 }
 
 json WallJson(const store::WallRecord& w) {
-    return {{"commit", w.commit},           {"wall_id", w.wall_id},
-            {"center", Vec(w.center)},      {"normal", Vec(w.normal)},
-            {"slant_deg", w.slant_deg},     {"uncertainty_deg", w.uncertainty_deg},
-            {"lean_azimuth_deg", w.lean_azimuth_deg}, {"area_m2", w.area_m2},
-            {"rms_m", w.rms_m},             {"length_m", w.length_m},
-            {"height_m", w.height_m},       {"inliers", w.inliers}};
+    return {{"commit", w.commit},
+            {"wall_id", w.wall_id},
+            {"center", Vec(w.center)},
+            {"normal", Vec(w.normal)},
+            {"slant_deg", w.slant_deg},
+            {"uncertainty_deg", w.uncertainty_deg},
+            {"lean_azimuth_deg", w.lean_azimuth_deg},
+            {"area_m2", w.area_m2},
+            {"rms_m", w.rms_m},
+            {"length_m", w.length_m},
+            {"height_m", w.height_m},
+            {"inliers", w.inliers}};
 }
 
 json VehicleJson(const store::VehicleRecord& v) {
-    return {{"commit", v.commit},       {"vehicle_id", v.vehicle_id},
-            {"center", Vec(v.center)},  {"size", Vec(v.size)},
-            {"yaw_deg", v.yaw_deg},     {"source", v.source},
-            {"voxels", v.voxels},       {"cleared_voxels", v.cleared_voxels},
-            {"refilled_cells", v.refilled_cells}, {"refused_cells", v.refused_cells}};
+    return {{"commit", v.commit},
+            {"vehicle_id", v.vehicle_id},
+            {"center", Vec(v.center)},
+            {"size", Vec(v.size)},
+            {"yaw_deg", v.yaw_deg},
+            {"source", v.source},
+            {"voxels", v.voxels},
+            {"cleared_voxels", v.cleared_voxels},
+            {"refilled_cells", v.refilled_cells},
+            {"refused_cells", v.refused_cells}};
 }
 
+// The row of a saved change set; its counts are in the report (added_voxels, removed_voxels,
+// unknown_voxels, objects).
 json ChangeSetJson(const store::ChangeSetRecord& r) {
-    return {{"id", r.id},
-            {"commit", r.commit},
-            {"created_utc", r.created_utc},
-            {"from", r.from},
-            {"to", r.to},
-            {"added_voxels", r.added_voxels},
-            {"removed_voxels", r.removed_voxels},
-            {"unknown_voxels", r.unknown_voxels},
-            {"objects", r.objects},
-            {"report", json::parse(r.report, nullptr, false)}};
+    return {
+        {"id", r.id},     {"commit", r.commit}, {"created_utc", r.created_utc},
+        {"from", r.from}, {"to", r.to},         {"report", json::parse(r.report, nullptr, false)}};
 }
 
 template <typename GridT>
@@ -77,7 +83,8 @@ change::ChangeQuery QueryOf(const json& report) {
     const json query = report.value("query", json::object());
     q.min_voxels = query.value("min_voxels", q.min_voxels);
     q.gap_voxels = query.value("gap_voxels", q.gap_voxels);
-    q.surface_tolerance_voxels = query.value("surface_tolerance_voxels", q.surface_tolerance_voxels);
+    q.surface_tolerance_voxels =
+        query.value("surface_tolerance_voxels", q.surface_tolerance_voxels);
     q.observed_margin_voxels = query.value("observed_margin_voxels", q.observed_margin_voxels);
     q.grow_voxels = query.value("grow_voxels", q.grow_voxels);
     q.support_depth_voxels = query.value("support_depth_voxels", q.support_depth_voxels);
@@ -104,8 +111,8 @@ int64_t SessionNamed(const store::MapStore& store, const std::string& id_or_name
         }
         known += (known.empty() ? "" : ", ") + std::to_string(session.id) + " " + session.name;
     }
-    throw NotFoundError(store.dir().string() + ": no session '" + id_or_name + "' (sessions: " +
-                        (known.empty() ? "none" : known) + ")");
+    throw NotFoundError(store.dir().string() + ": no session '" + id_or_name +
+                        "' (sessions: " + (known.empty() ? "none" : known) + ")");
 }
 
 }  // namespace
@@ -162,8 +169,7 @@ std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::str
         throw NotFoundError(dir.string() + ": no map here (create one with `strata integrate " +
                             dir.string() + " --kitti SEQ` or `strata demo`)");
     }
-    auto impl =
-        std::make_unique<Impl>(store::MapStore::Open(dir, store::MapStore::Access::kRead));
+    auto impl = std::make_unique<Impl>(store::MapStore::Open(dir, store::MapStore::Access::kRead));
     Impl& s = *impl;
     const store::MapSettings& settings = s.store.settings();
     s.facts = {fs::absolute(dir).lexically_normal().filename().string(), settings.voxel_size_m,

@@ -34,9 +34,9 @@ json ViewService::Impl::VoxelRecord(int64_t commit, const openvdb::Coord& ijk) {
              {"observed", false}};
     const int32_t n = source->facts().tile_voxels;
     const auto floor_div = [n](int32_t v) { return v >= 0 ? v / n : -((-v + n - 1) / n); };
-    const auto tile = std::find_if(snapshot->tiles.begin(), snapshot->tiles.end(), [&](const TileRef& t) {
-        return t.x == floor_div(ijk.x()) && t.y == floor_div(ijk.y());
-    });
+    const auto tile = std::find_if(
+        snapshot->tiles.begin(), snapshot->tiles.end(),
+        [&](const TileRef& t) { return t.x == floor_div(ijk.x()) && t.y == floor_div(ijk.y()); });
     if (tile == snapshot->tiles.end()) return out;
     const auto grids = Tile(*tile);
     out["tile"] = {{"x", tile->x}, {"y", tile->y}, {"version", tile->version}};
@@ -48,7 +48,8 @@ json ViewService::Impl::VoxelRecord(int64_t commit, const openvdb::Coord& ijk) {
         out["probability"] = core::Probability(log_odds);
     }
     if (grids->label) {
-        const auto c = static_cast<core::SemanticClass>(grids->label->getConstAccessor().getValue(ijk));
+        const auto c =
+            static_cast<core::SemanticClass>(grids->label->getConstAccessor().getValue(ijk));
         out["class"] = core::ClassName(c);
     }
     if (grids->hits) out["hits"] = grids->hits->getConstAccessor().getValue(ijk);

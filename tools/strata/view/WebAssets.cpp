@@ -31,7 +31,8 @@ std::string ReadThree(const std::string& relative) {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream text;
     if (!(in && text << in.rdbuf())) {
-        throw NotFoundError(path.string() + ": three.js is missing; install Debian's libjs-three "
+        throw NotFoundError(path.string() +
+                            ": three.js is missing; install Debian's libjs-three "
                             "(tools/setup.sh does)");
     }
     return text.str();

@@ -68,7 +68,7 @@ strata.Viewer.prototype.placeCamera = function () {
   } else {
     var center = this.bounds.getCenter(new THREE.Vector3());
     var radius = this.bounds.getSize(new THREE.Vector3()).length() / 2;
-    var d = 1.1 * radius / Math.sin(this.camera.fov * Math.PI / 360);
+    var d = 0.9 * radius / Math.sin(this.camera.fov * Math.PI / 360);
     var up = 40 * Math.PI / 180;
     this.camera.position.copy(center).add(
       new THREE.Vector3(0, -Math.cos(up), Math.sin(up)).multiplyScalar(d));

@@ -6,7 +6,10 @@ var strata = window.strata || (window.strata = {});
 strata.COLORS = ['class', 'height', 'session', 'slant'];
 
 strata.parseHash = function (hash, manifest) {
-  var state = { camera: null, color: 'class', session: manifest.snapshots[0].as_of_session,
+  // Colour by class when the map has classes, else by height (a map of unlabelled scans).
+  var labelled = manifest.snapshots[0].tiles.some(function (t) { return t.labelled_voxels > 0; });
+  var state = { camera: null, color: labelled ? 'class' : 'height',
+                session: manifest.snapshots[0].as_of_session,
                 diff: null, changeset: null, free: null, ui: true,
                 layers: { walls: true, vehicles: true, cleared: false } };
   var numbers = function (text) { return text.split(',').map(Number); };

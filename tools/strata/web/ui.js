@@ -34,8 +34,9 @@ strata.Ui = function (viewer) {
   viewer.manifest.change_sets.forEach(function (s) {
     var option = document.createElement('option');
     option.value = s.id;
-    option.textContent = '#' + s.id + ' ' + s.from + ' → ' + s.to + ' (+' + s.added_voxels +
-                         ' / −' + s.removed_voxels + ')';
+    var r = s.report || {};
+    option.textContent = '#' + s.id + ' ' + s.from + ' → ' + s.to + ' (+' + r.added_voxels +
+                         ' / −' + r.removed_voxels + ')';
     sets.appendChild(option);
   });
   sets.value = state.changeset || '';
