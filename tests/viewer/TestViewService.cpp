@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -229,6 +230,33 @@ TEST(ViewService, KeepsServingItsSnapshotWhileTheMapMovesOn) {
             EXPECT_EQ(service->Get(path).status, 404) << path;
         }
     }
+}
+
+TEST(ViewService, ADamagedTileFileStopsTheStartWithItsNameAndTheMapUntouched) {
+    const TestMap map = BuildTestMap("damaged");
+    const json tile = Get(*Service(map.dir), "/api/map")["snapshots"][0]["tiles"][0];
+    // MAP/tiles/X_Y/vN.vdb (MapStore.hpp): a version the newest snapshot reads.
+    const fs::path victim =
+        map.dir / "tiles" /
+        (std::to_string(tile["x"].get<int>()) + "_" + std::to_string(tile["y"].get<int>())) /
+        ("v" + std::to_string(tile["version"].get<int64_t>()) + ".vdb");
+    ASSERT_TRUE(fs::is_regular_file(victim));
+    {
+        std::fstream file(victim, std::ios::in | std::ios::out | std::ios::binary);
+        file.seekp(static_cast<std::streamoff>(fs::file_size(victim) / 2));
+        file.put('\x5a').put('\xa5');
+    }
+    const auto bytes = fs::file_size(victim);
+    const auto catalog = fs::last_write_time(map.dir / "catalog.sqlite");
+    try {
+        (void)Service(map.dir);
+        ADD_FAILURE() << "a damaged tile was served";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find(victim.filename().string()), std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(fs::file_size(victim), bytes);
+    EXPECT_EQ(fs::last_write_time(map.dir / "catalog.sqlite"), catalog);
 }
 
 TEST(ViewService, AMissingMapIsNotFound) {

@@ -23,6 +23,7 @@ strata.TileSet = function (group, tiles, maxLod, voxelM, build) {
   });
   this.inFlight = 0;
   this.cells = 0;
+  this.planned = false;  // no camera has chosen levels yet: not settled
   this.onchange = function () {};
 };
 
@@ -45,6 +46,7 @@ strata.TileSet.prototype.plan = function (camera, scale) {
   var frustum = new THREE.Frustum().setFromMatrix(
     new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse));
   var set = this;
+  this.planned = true;
   this.entries.forEach(function (e) {
     if (!frustum.intersectsBox(e.box)) { e.wanted = -1; return; }
     var d = Math.max(e.box.distanceToPoint(camera.position), 1e-3);
@@ -94,7 +96,7 @@ strata.TileSet.prototype.fetch = function (e, lod) {
 
 // True when every tile in view is drawn at its wanted level and nothing is loading.
 strata.TileSet.prototype.settled = function () {
-  return this.inFlight === 0 && this.entries.every(function (e) {
+  return this.planned && this.inFlight === 0 && this.entries.every(function (e) {
     return e.wanted < 0 || e.failed || e.shownLod === e.wanted;
   });
 };
