@@ -24,6 +24,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   bzip2 libbz2-dev
   clang libclang-rt-14-dev  # tools/fuzz.sh: libFuzzer and the sanitizer runtimes (clang 14)
+  libcpp-httplib-dev libjs-three                     # strata view: its server, three.js
+  chromium python3-pytest python3-websocket          # strata view's browser tests
 )
 
 missing=()
