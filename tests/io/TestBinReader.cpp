@@ -15,6 +15,7 @@ namespace strata::io {
 namespace {
 
 namespace fs = std::filesystem;
+using test_files::DataDir;
 using test_files::TempDir;
 using test_files::WriteFile;
 
@@ -130,7 +131,7 @@ TEST(BinReader, SubtractsTheOriginAndRefusesFieldCountsOtherThanFourAndFive) {
 
 TEST(BinReader, ReadsRealKittiScansAsTheSequenceReaderDoes) {
     STRATA_REQUIRE_DATA("kitti00");
-    const fs::path path = fs::path(test_files::DataDir()) / "kitti00" / "velodyne" / "000000.bin";
+    const fs::path path = fs::path(DataDir()) / "kitti00" / "velodyne" / "000000.bin";
     const core::Scan scan = ReadPointCloud(path);
     const KittiPoints raw = ReadKittiBin(path);
     ASSERT_GT(scan.points.size(), 100000u);  // a full HDL-64E sweep
