@@ -110,8 +110,10 @@ TEST(BinReader, AnEmptyFileIsAScanWithoutPoints) {
 TEST(BinReader, HugeFiniteValuesAreKeptAndInfinitePointsDropped) {
     TempDir dir;
     const float big = std::numeric_limits<float>::max();
-    WriteFile(dir / "huge.bin", Floats({big, -big, 1e30f, kInf, 1.f, 2.f, 3.f, 0.f, -kInf, 0.f, 0.f,
-                                        0.f, 1.f, 1.f, 1.f, big}));
+    WriteFile(dir / "huge.bin", Floats({big, -big, 1e30f, 0.5f,  // kept as it is
+                                        kInf, 1.f, 1.f, 0.f,     // dropped
+                                        0.f, 0.f, -kInf, 0.f,    // dropped
+                                        1.f, 1.f, 1.f, big}));   // kept, a huge intensity
     const core::Scan scan = ReadPointCloud(dir / "huge.bin");
     ASSERT_EQ(scan.points.size(), 2u);
     EXPECT_EQ(scan.points[0], Eigen::Vector3d(big, -big, 1e30f));
