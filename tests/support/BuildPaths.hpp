@@ -11,7 +11,17 @@ namespace strata::build_paths {
 [[nodiscard]] const char* EioShim();    ///< tests/tools/EioShim.cpp's library ("" when not built)
 }  // namespace strata::build_paths
 
+// A target that still defines one of them with -D keeps its own (and its objects' command lines
+// then hold the path again).
+#ifndef STRATA_SOURCE_DIR
 #define STRATA_SOURCE_DIR (::strata::build_paths::SourceDir())
+#endif
+#ifndef STRATA_DATA_DIR
 #define STRATA_DATA_DIR (::strata::build_paths::DataDir())
+#endif
+#ifndef STRATA_BINARY
 #define STRATA_BINARY (::strata::build_paths::Binary())
+#endif
+#ifndef STRATA_EIO_SHIM
 #define STRATA_EIO_SHIM (::strata::build_paths::EioShim())
+#endif
