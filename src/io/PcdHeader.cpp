@@ -51,7 +51,8 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
         auto number = [&](unsigned long long max) {
             unsigned long long v = 0;
             if (values.size() != 1 || !ParseUint(values[0], v) || v > max) {
-                FailHeader(file, n, std::string(key) + " needs one integer up to " + std::to_string(max));
+                FailHeader(file, n,
+                           std::string(key) + " needs one integer up to " + std::to_string(max));
             }
             return v;
         };
@@ -90,7 +91,8 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
             }
             has_data = true;
         } else {
-            FailHeader(file, n, "unknown key '" + std::string(key.substr(0, 32)) + "' (not a PCD file?)");
+            FailHeader(file, n,
+                       "unknown key '" + std::string(key.substr(0, 32)) + "' (not a PCD file?)");
         }
     }
     const size_t n = lines.line_number();
@@ -115,7 +117,8 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
                      " with SIZE " + std::string(sizes[i]));
         }
         if (!counts.empty() && (!ParseUint(counts[i], count) || count == 0 || count > kMaxCount)) {
-            FailHeader(file, n, "field '" + field.name + "' has invalid COUNT " + std::string(counts[i]));
+            FailHeader(file, n,
+                       "field '" + field.name + "' has invalid COUNT " + std::string(counts[i]));
         }
         field.size = static_cast<size_t>(size);
         field.count = static_cast<size_t>(count);
