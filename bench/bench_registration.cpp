@@ -144,9 +144,7 @@ int Run(const fs::path& data, int repeat) {
     reg::FloorSlice slice;
     slice.l1_m = -0.2;
     slice.l2_m = 3.1;
-    reg::RegistrationConfig loc;
-    loc.surface.level_cells_m = {1.0, 0.5, 0.25};
-    loc.max_source_points = 1500;
+    reg::RegistrationConfig loc = reg::LocalizationRegistration();
     loc.min_source_range_m = 0.5;
     const auto points = reg::OccupiedPoints(map, slice.Box(3.5));
     Row row;

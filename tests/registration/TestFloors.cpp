@@ -10,6 +10,7 @@
 #include <functional>
 #include <sstream>
 
+#include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/registration/Floors.hpp"
@@ -30,7 +31,7 @@ constexpr double kLocalizationRmseM = 0.05;
 constexpr double kFloorHeightM = 3.5;  // building.json, building_stairwell.json
 // z-biases off by -150 mm, 0 and +150 mm (4.3 % of the storey height, within the +-0.6 m search).
 constexpr double kZBiasesM[] = {3.35, 3.5, 3.65};
-constexpr int kScansPerFloor = 40;     // the whole corridor (12 scans see 8 m of it)
+constexpr int kScansPerFloor = 40;  // the whole corridor (12 scans see 8 m of it)
 constexpr double kVoxel = 0.1;
 
 struct Building {
@@ -231,9 +232,7 @@ TEST(RegistrationFloors, LocalizesEveryScanOfAFloorInItsSlice) {
     FloorSlice slice;  // the storey, its floor and ceiling included, nothing of the others
     slice.l1_m = -0.2;
     slice.l2_m = 3.1;
-    RegistrationConfig config;
-    config.surface.level_cells_m = {1.0, 0.5, 0.25};
-    config.max_source_points = 1500;
+    RegistrationConfig config = LocalizationRegistration();
     config.min_source_range_m = 0.5;
     const Surface surface =
         Surface::FromPoints(OccupiedPoints(map, slice.Box(z_floor)), config.surface);
@@ -265,20 +264,20 @@ TEST(RegistrationFloors, SliceAndConfigChecks) {
     FloorSlice slice;
     slice.l1_m = 2.0;
     slice.l2_m = 1.0;
-    EXPECT_THROW(slice.Validate(), std::invalid_argument);
+    EXPECT_THROW(slice.Validate(), InvalidArgumentError);
     const Eigen::AlignedBox3d box = FloorSlice{}.Box(3.5);
     EXPECT_TRUE(box.contains(Eigen::Vector3d(100, -50, 4.0)));
     EXPECT_FALSE(box.contains(Eigen::Vector3d(0, 0, 3.6)));
     FloorStackConfig config;
     config.yaw_step_deg = 0.0;
-    EXPECT_THROW(config.Validate(), std::invalid_argument);
-    EXPECT_THROW((void)StackFloor({}, 0.0, {}, FloorStackConfig{}), std::invalid_argument);
+    EXPECT_THROW(config.Validate(), InvalidArgumentError);
+    EXPECT_THROW((void)StackFloor({}, 0.0, {}, FloorStackConfig{}), InvalidArgumentError);
     FloorHeightConfig height;
     height.inlier_m = 0.0;
-    EXPECT_THROW(height.Validate(), std::invalid_argument);
+    EXPECT_THROW(height.Validate(), InvalidArgumentError);
     height = FloorHeightConfig{};
     height.slab_band_m = height.search_m;
-    EXPECT_THROW(height.Validate(), std::invalid_argument);
+    EXPECT_THROW(height.Validate(), InvalidArgumentError);
 }
 
 }  // namespace

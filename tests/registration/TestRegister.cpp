@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "SyntheticGeometry.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/registration/Register.hpp"
 
 namespace strata::registration {
@@ -86,14 +87,17 @@ TEST(RegistrationIcp, RefusesADegenerateCorridor) {
 TEST(RegistrationIcp, RejectsBadConfigAndEmptyTarget) {
     RegistrationConfig config;
     config.surface.level_cells_m = {0.5, 1.0};
-    EXPECT_THROW(config.Validate(), std::invalid_argument);
+    EXPECT_THROW(config.Validate(), InvalidArgumentError);
     config = {};
     config.min_overlap = 2.0;
-    EXPECT_THROW(config.Validate(), std::invalid_argument);
+    EXPECT_THROW(config.Validate(), InvalidArgumentError);
+    config = {};
+    config.max_finest_source_points = 10;
+    EXPECT_THROW(config.Validate(), InvalidArgumentError);
     const Surface empty = Surface::FromPoints({}, RegistrationConfig{}.surface);
     EXPECT_TRUE(empty.empty());
     EXPECT_THROW((void)RegisterPoints(empty, Street(1), Eigen::Isometry3d::Identity()),
-                 std::invalid_argument);
+                 InvalidArgumentError);
 }
 
 TEST(RegistrationSurface, FitsNormalsOfPlanesAndDropsNothingPlanar) {

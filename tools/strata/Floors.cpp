@@ -171,9 +171,7 @@ void RunLocalize(const LocalizeArgs& args) {
             if (box.contains(p)) slice.push_back(p);
         }
     }
-    reg::RegistrationConfig config = args.align.config;
-    config.surface.level_cells_m = {1.0, 0.5, 0.25};
-    config.max_source_points = 1500;
+    reg::RegistrationConfig config = args.align.config;  // LocalizationRegistration + options
     config.min_source_range_m = args.align.min_range_m;
     config.max_source_range_m = args.align.max_range_m;
     const reg::Surface surface = reg::Surface::FromPoints(slice, config.surface);
@@ -242,6 +240,7 @@ void RegisterFloors(CLI::App& app) {
         ->capture_default_str();
     lcmd->add_flag("--json", loc->json, "Print the result as JSON");
     loc->align.min_range_m = 0.5;
+    loc->align.config = reg::LocalizationRegistration();
     AddAlignOptions(*lcmd, loc->align);
     lcmd->callback([loc] { RunLocalize(*loc); });
 }
