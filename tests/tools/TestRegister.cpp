@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "CliTestUtil.hpp"
+#include "RealPairs.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::tools::test {
@@ -101,6 +102,40 @@ TEST(RegistrationCli, FindsASessionRecordedInAMovedFrameWithTheFixedKeys) {
     RecordProperty("error_deg", std::to_string(dr));
     EXPECT_LT(dt, kTranslationTolM) << r.out;
     EXPECT_LT(dr, kRotationTolDeg) << r.out;
+}
+
+// Real data through the program: KITTI 00 frame 5 against a map of frame 0 (0.1 m), from a
+// guess 0.5 m / 3 deg off the raw-point optimum (tests/support/RawIcp.hpp), which the library
+// test measures in detail (RegistrationRealData.*).
+TEST(RegistrationCli, RegistersAKitti00ScanOnTheRawPointOptimum) {
+    using namespace registration::test;                 // NOLINT: the real-data references
+    constexpr double kVsRawDeg = 0.03, kVsRawM = 0.005;  // measured 0.012 deg, 1.9 mm
+    const fs::path dir = fs::path(STRATA_DATA_DIR) / "kitti00";
+    if (!fs::exists(dir / "poses_sptam.txt")) GTEST_SKIP() << dir << " (stereo poses) not found";
+    const Kitti00 k = LoadKitti00(dir);
+    const RawOptimum::Result opt =
+        RawOptimum(RangeFiltered(k.scans[0], 0.0, kMapMaxRangeM))
+            .Align(RangeFiltered(k.scans[5], kScanMinRangeM, kScanMaxRangeM),
+                   k.orbslam2[0].inverse() * k.orbslam2[5]);
+    const fs::path map = Temp("register_kitti");
+    ASSERT_EQ(Strata("integrate " + map.string() + " --kitti " + dir.string() +
+                     " --frames 0:1 --voxel 0.1")
+                  .code,
+              0);
+    const Eigen::Isometry3d guess = Off(opt.mean);
+    const Eigen::Vector3d t = guess.translation();
+    const Result r =
+        Strata("register " + map.string() + " --kitti " + dir.string() + " --frames 5:6 --json" +
+               " --init " + std::to_string(t.x()) + "," + std::to_string(t.y()) + "," +
+               std::to_string(t.z()) + "," + std::to_string(registration::YawDeg(guess)));
+    ASSERT_EQ(r.code, 0) << r.out;
+    const json j = json::parse(r.out.substr(r.out.find('{')));
+    const PoseGap g = Gap(opt.mean, Eigen::Isometry3d(FromJson(j["T"])));
+    RecordProperty("vs_raw_m", std::to_string(g.m));
+    RecordProperty("vs_raw_deg", std::to_string(g.deg));
+    std::cout << "vs raw " << g.m << " m " << g.deg << " deg\n";
+    EXPECT_LT(g.deg, kVsRawDeg) << r.out;
+    EXPECT_LT(g.m, kVsRawM) << r.out;
 }
 
 TEST(RegistrationCli, RefusesAGuessFarOffAndSaysWhy) {
