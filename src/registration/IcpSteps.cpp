@@ -18,25 +18,40 @@ Eigen::Vector3d Centroid(const std::vector<Match>& matches) {
     return c / static_cast<double>(matches.size());
 }
 
-// The nearest point of `level` to p within one cell size, or -1.
+// The nearest point of `level` to p within one cell size, or -1. Points lie in their own cell,
+// so the cell of p is searched first and a neighbour only when its box is nearer to p than the
+// best point so far (exact; usually a few of the 27 cells are probed).
 int32_t NearestInLevel(const SurfaceLevel& level, const openvdb::Int32Grid::ConstAccessor& acc,
                        const Eigen::Vector3d& p) {
     const double inv_cell = 1.0 / level.cell_m;
-    const openvdb::Coord c(static_cast<int32_t>(std::floor(p.x() * inv_cell)),
-                           static_cast<int32_t>(std::floor(p.y() * inv_cell)),
-                           static_cast<int32_t>(std::floor(p.z() * inv_cell)));
+    const Eigen::Vector3d f = (p * inv_cell).array().floor();
+    const openvdb::Coord c(static_cast<int32_t>(f.x()), static_cast<int32_t>(f.y()),
+                           static_cast<int32_t>(f.z()));
+    // Distance from p to the lower and upper faces of its cell, per axis.
+    const Eigen::Vector3d below = p - f * level.cell_m;
+    const Eigen::Vector3d above = Eigen::Vector3d::Constant(level.cell_m) - below;
     double best = level.cell_m * level.cell_m;
     int32_t best_j = -1;
+    const auto Try = [&](const openvdb::Coord& cell) {
+        int32_t j = -1;
+        if (!acc.probeValue(cell, j)) return;
+        const double d2 = (level.points[static_cast<size_t>(j)] - p).squaredNorm();
+        if (d2 < best) {
+            best = d2;
+            best_j = j;
+        }
+    };
+    Try(c);
     for (int dx = -1; dx <= 1; ++dx) {
+        const double gx = dx < 0 ? below.x() : (dx > 0 ? above.x() : 0.0);
         for (int dy = -1; dy <= 1; ++dy) {
+            const double gy = dy < 0 ? below.y() : (dy > 0 ? above.y() : 0.0);
             for (int dz = -1; dz <= 1; ++dz) {
-                int32_t j = -1;
-                if (!acc.probeValue(c.offsetBy(dx, dy, dz), j)) continue;
-                const double d2 = (level.points[static_cast<size_t>(j)] - p).squaredNorm();
-                if (d2 < best) {
-                    best = d2;
-                    best_j = j;
+                const double gz = dz < 0 ? below.z() : (dz > 0 ? above.z() : 0.0);
+                if ((dx == 0 && dy == 0 && dz == 0) || gx * gx + gy * gy + gz * gz >= best) {
+                    continue;
                 }
+                Try(c.offsetBy(dx, dy, dz));
             }
         }
     }
@@ -83,7 +98,7 @@ Eigen::Isometry3d SolveIncrement(const std::vector<Match>& matches, double robus
     }
     double x[6] = {0, 0, 0, 0, 0, 0};
     ceres::Problem problem;
-    problem.AddResidualBlock(PointToPlaneBatchCost::Create(&planes), nullptr, x);
+    problem.AddResidualBlock(new PointToPlaneBatchAnalytic(&planes), nullptr, x);
     // Planar: roll, pitch (angle-axis x, y) and z stay zero.
     if (planar) problem.SetManifold(x, new ceres::SubsetManifold(6, {0, 1, 5}));
     ceres::Solver::Options options;
