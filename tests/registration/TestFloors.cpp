@@ -22,11 +22,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Issue #8: stacked floors within 0.05 m in x and y, 0.2 deg in yaw, z error rate <= 0.01;
-// localization RMSE <= 0.05 m.
-constexpr double kStackXyTolM = 0.05;
-constexpr double kStackYawTolDeg = 0.2;
-constexpr double kMaxZErrorRate = 0.01;
+// Issue #8's targets are 0.05 m in x and y, 0.2 deg in yaw, z error rate 0.01, localization
+// RMSE 0.05 m; the bounds below are 2-3x what these tests measure (docs/registration.md), all
+// inside the targets. Measured at most: x 0.023 m, y 0.004 m, yaw 0.017 deg, z 1.2 mm over
+// 3.5 m (rate 0.00034), localization RMSE 0.018 m.
+constexpr double kStackXTolM = 0.05;
+constexpr double kStackYTolM = 0.01;
+constexpr double kStackYawTolDeg = 0.05;
+constexpr double kMaxZErrorRate = 0.001;
 constexpr double kLocalizationRmseM = 0.05;
 constexpr double kFloorHeightM = 3.5;  // building.json, building_stairwell.json
 // z-biases off by -150 mm, 0 and +150 mm (4.3 % of the storey height, within the +-0.6 m search).
@@ -122,8 +125,8 @@ TEST(RegistrationFloors, StacksTheCorridorOnlyBuildingInXyYawButRefusesToGuessZ)
         const Eigen::Isometry3d truth = T_map_world * b.spec.sessions[k].T_world_session;
         const Eigen::Vector3d dt = r.result.T_map_source.translation() - truth.translation();
         const double dyaw = YawDeg(truth.inverse() * r.result.T_map_source);
-        EXPECT_LT(std::abs(dt.x()), kStackXyTolM) << "floor " << k;
-        EXPECT_LT(std::abs(dt.y()), kStackXyTolM) << "floor " << k;
+        EXPECT_LT(std::abs(dt.x()), kStackXTolM) << "floor " << k;
+        EXPECT_LT(std::abs(dt.y()), kStackYTolM) << "floor " << k;
         EXPECT_LT(std::abs(dyaw), kStackYawTolDeg) << "floor " << k << [&] {
             std::ostringstream os;
             for (const RegistrationResult& c : r.candidates) {
@@ -164,8 +167,8 @@ TEST(RegistrationFloors, MeasuresZThroughTheStairwellFromAWrongZBias) {
         ASSERT_TRUE(r.height.measured);
         const Eigen::Vector3d dt = r.result.T_map_source.translation() - truth.translation();
         const double dyaw = YawDeg(truth.inverse() * r.result.T_map_source);
-        EXPECT_LT(std::abs(dt.x()), kStackXyTolM) << "z-bias " << z_bias;
-        EXPECT_LT(std::abs(dt.y()), kStackXyTolM) << "z-bias " << z_bias;
+        EXPECT_LT(std::abs(dt.x()), kStackXTolM) << "z-bias " << z_bias;
+        EXPECT_LT(std::abs(dt.y()), kStackYTolM) << "z-bias " << z_bias;
         EXPECT_LT(std::abs(dyaw), kStackYawTolDeg) << "z-bias " << z_bias;
         EXPECT_LE(std::abs(dt.z()) / kFloorHeightM, kMaxZErrorRate)
             << "z-bias " << z_bias << ": z " << r.height.z_m << ", " << r.height.matches
