@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "CliTestUtil.hpp"
+#include "StoreFaultUtil.hpp"
 #include "MapDiff.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/store/MapStore.hpp"
@@ -44,20 +45,22 @@ using strata::tools::test::Spawn;
 using strata::tools::test::Strata;
 using strata::tools::test::Temp;
 using strata::tools::test::Wait;
+using strata::tools::test::FaultSequence;
+using strata::tools::test::IntegrateArgs;
+using strata::tools::test::Join;
+using strata::tools::test::JsonIn;
+using strata::tools::test::KillAttempts;
+using strata::tools::test::LoadLatest;
+using strata::tools::test::OpenForReading;
+using strata::tools::test::SameMap;
+using strata::tools::test::Seed;
+using strata::tools::test::SessionCount;
+using strata::tools::test::kSequenceScans;
+using strata::tools::test::kTileM;
+using strata::tools::test::kVoxelM;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kVoxelM = 0.1;
-// 40 voxels: one scan touches ~12 tiles, so a commit writes ~12 files.
-constexpr double kTileM = 4.0;
 constexpr double kOneTileM = 64.0;  // with --origin 32,32,0 the whole room is in one tile
-constexpr int kSequenceScans = 4;
-constexpr unsigned kDefaultSeed = 20240611;  // STRATA_FAULT_SEED overrides it to reproduce a run
-// Kills per run of the crash test; STRATA_KILL_ATTEMPTS raises it for long local runs
-// (docs/reliability.md reports one of 120).
-int KillAttempts() {
-    const char* env = std::getenv("STRATA_KILL_ATTEMPTS");
-    return env && *env ? std::max(1, std::atoi(env)) : 20;
-}
 // Reader processes and the sessions the writer commits while they read.
 constexpr int kReaders = 3;
 constexpr int kWriterSessions = 6;
@@ -65,59 +68,6 @@ constexpr double kCommitMarginS = 0.05;  // the commit window starts a little ea
 constexpr double kHangGuardS = 5.0;  // a refused writer returns at once; this only catches hangs
 constexpr rlim_t kSmallFileLimit = 64 << 10;   // below one tile file (>100 kB) and a new catalog
 constexpr rlim_t kLargeFileLimit = 512 << 10;  // a new catalog fits, one 64 m tile (~1 MB) not
-
-// One scan (12k points in a 10 x 8 x 3 m room) per session: ~0.4 s per `strata integrate`, half
-// of it the commit of ~12 tile files of 100-300 kB (tiles hold every session's layers).
-SequenceSpec FaultSequence() {
-    SequenceSpec spec;
-    spec.scans = kSequenceScans;
-    spec.points_per_scan = 12000;
-    spec.room_half_m = Eigen::Vector3d(5.0, 4.0, 1.5);
-    return spec;
-}
-
-// Session `session` (1-based) integrates frame (session - 1) mod 4 of `seq`: the same session
-// number always gets the same input, in any map.
-std::vector<std::string> IntegrateArgs(const fs::path& map, const fs::path& seq, int session,
-                                       double tile_m = kTileM) {
-    return {"integrate",   map.string(),
-            "--kitti",     seq.string(),
-            "--frames",    std::to_string((session - 1) % kSequenceScans),
-            "--voxel",     std::to_string(kVoxelM),
-            "--tile-size", std::to_string(tile_m)};
-}
-
-std::string Join(const std::vector<std::string>& words) {
-    std::string line;
-    for (const std::string& w : words) line += (line.empty() ? "" : " ") + w;
-    return line;
-}
-
-// The JSON object in a command's output (stderr lines, unbuffered, may come before it).
-nlohmann::json JsonIn(const std::string& out) {
-    const size_t begin = out.find('{');
-    const size_t end = out.rfind('}');
-    if (begin == std::string::npos || end == std::string::npos) return {};
-    return nlohmann::json::parse(out.substr(begin, end - begin + 1), nullptr, false);
-}
-
-MapStore OpenForReading(const fs::path& map) {
-    return MapStore::Open(map, MapStore::Access::kRead);
-}
-
-size_t SessionCount(const fs::path& map) { return OpenForReading(map).Latest().sessions.size(); }
-
-VoxelMap LoadLatest(const fs::path& map) {
-    const MapStore store = OpenForReading(map);
-    return store.LoadMap(store.Latest());
-}
-
-// Exact equality of two maps, voxel by voxel: occupancy, label, label weight and hits.
-::testing::AssertionResult SameMap(const VoxelMap& actual, const VoxelMap& expected) {
-    const std::string diff = strata::testing::MapDifference(actual, expected);
-    if (!diff.empty()) return ::testing::AssertionFailure() << diff;
-    return ::testing::AssertionSuccess();
-}
 
 // The maps a run without faults produces, built one session ahead of the map under test (which
 // has n or n + 1 sessions after an attempt at session n + 1), and how long each session took.
@@ -165,11 +115,6 @@ private:
     std::map<int, VoxelMap> maps_;
     std::map<int, Timing> timings_;
 };
-
-unsigned Seed() {
-    const char* env = std::getenv("STRATA_FAULT_SEED");
-    return env && *env ? static_cast<unsigned>(std::stoul(env)) : kDefaultSeed;
-}
 
 // Every file the map directory may hold besides tiles/ (SQLite's WAL files come and go).
 bool IsMapFile(const std::string& name) {
@@ -642,11 +587,11 @@ TEST(StoreFaults, DamagedTileFilesAreNamed) {
 
     for (const auto& tile : tiles) {
         if (tile.file == flipped.file || tile.file == truncated.file) continue;
-        EXPECT_NO_THROW((void)store.ReadTile(tile)) << tile.file;
+        EXPECT_NO_THROW((void)store.ReadFused(tile)) << tile.file;
     }
     const auto error_of = [&](const strata::store::TileVersion& tile) -> std::string {
         try {
-            (void)store.ReadTile(tile);
+            (void)store.ReadFused(tile);
         } catch (const std::runtime_error& e) {
             return e.what();
         }

@@ -111,23 +111,23 @@ TEST(WallsCli, StoresTheProductsInTheMap) {
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_NE(r.out.find("stored slant_deg and wall_id grids"), std::string::npos) << r.out;
     const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
-    const auto walls = store.Walls();
+    const auto walls = store.ProductRows("walls");
     ASSERT_FALSE(walls.empty());
     size_t stored = 0;
-    for (const auto& v : store.Latest().tiles) {
-        for (const auto& g : store.ReadTile(v).products) {
+    for (const auto& p : store.Latest().products) {
+        for (const auto& g : store.ReadProduct(p)) {
             if (g->getName() == "slant_deg") stored += g->activeVoxelCount();
         }
     }
     size_t inliers = 0;
-    for (const auto& w : walls) inliers += w.inliers;
+    for (const auto& w : walls) inliers += nlohmann::json::parse(w.json)["inliers"].get<size_t>();
     // Every inlier voxel is stored once; a voxel two walls share (a corner) keeps one id.
     EXPECT_LE(stored, inliers);
     EXPECT_GE(stored, static_cast<size_t>(kMinDistinctInliers * inliers));
     EXPECT_TRUE(store.Check().ok());
     // Running again replaces them; the map as of the session is readable and has none.
     EXPECT_EQ(Strata("walls " + map.string()).code, 0);
-    EXPECT_EQ(store::MapStore::Open(map, store::MapStore::Access::kRead).Walls().size(),
+    EXPECT_EQ(store::MapStore::Open(map, store::MapStore::Access::kRead).ProductRows("walls").size(),
               walls.size());
     EXPECT_EQ(Strata("walls " + map.string() + " --as-of 1 --json").code, 0);
 }
@@ -149,7 +149,8 @@ TEST(WallsCli, BadInputFailsNamingTheProblemAndLeavesTheMap) {
         EXPECT_NE(r.out.find(what), std::string::npos) << args << ": " << r.out;
     }
     EXPECT_EQ(MapFiles(map), before);
-    EXPECT_TRUE(store::MapStore::Open(map, store::MapStore::Access::kRead).Walls().empty());
+    EXPECT_TRUE(
+        store::MapStore::Open(map, store::MapStore::Access::kRead).ProductRows("walls").empty());
 }
 
 }  // namespace
