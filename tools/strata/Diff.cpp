@@ -88,9 +88,12 @@ void List(const DiffArgs& args) {
             throw FormatError(map.dir().string() + ": change set " + std::to_string(row.id) +
                               " is damaged");
         }
-        j["id"] = row.id;
-        j["commit"] = row.commit;
-        sets.push_back(j);
+        // The list keeps the keys it always had: the view's from_side/to_side as from/to.
+        nlohmann::json entry = {{"id", row.id}, {"commit", row.commit}};
+        for (const auto& [key, value] : j.items()) {
+            entry[key == "from_side" ? "from" : key == "to_side" ? "to" : key] = value;
+        }
+        sets.push_back(entry);
     }
     if (args.json) {
         std::cout << sets.dump(2) << "\n";
@@ -99,7 +102,7 @@ void List(const DiffArgs& args) {
     if (sets.empty()) std::cout << "no saved change sets (strata diff ... --save keeps one)\n";
     for (const nlohmann::json& r : sets) {
         std::cout << r["id"] << "  " << r.value("created_utc", "") << "  "
-                  << r.value("from_side", "") << " -> " << r.value("to_side", "") << ": "
+                  << r.value("from", "") << " -> " << r.value("to", "") << ": "
                   << r.value("objects", 0) << " objects, +" << r.value("added_voxels", 0)
                   << " / -" << r.value("removed_voxels", 0) << " voxels\n";
     }
