@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "CliTestUtil.hpp"
+#include "Format4Map.hpp"
 #include "StoreFaultUtil.hpp"
 #include "MapDiff.hpp"
 #include "strata/core/VoxelMap.hpp"
@@ -629,6 +630,91 @@ TEST(StoreFaults, NewerFormatsAndNonMapsAreRefused) {
     const Result r = Strata("info " + empty.string());
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("not a strata map"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// The integration rule is recorded when the map is created: a later `integrate` with a flag that
+// contradicts it fails naming the flag, the map's value and the given one, and writes nothing; the
+// same flag with the map's value, or no flag, is fine.
+TEST(StoreFaults, IntegrateRefusesFlagsThatContradictTheMapsRule) {
+    const Fixture f = MakeMap("faults_rule", 0);
+    std::vector<std::string> first = IntegrateArgs(f.map, f.seq, 1);
+    first.insert(first.end(), {"--max-range", "30"});
+    ASSERT_EQ(Strata(Join(first)).code, 0);
+    const auto files_before = MapFiles(f.map);
+    for (const auto& [flag, named] : std::vector<std::pair<std::string, std::string>>{
+             {"--max-range 40", "--max-range 40: "},
+             {"--min-range 1", "--min-range 1: "},
+             {"--points-only", "--points-only: "},
+             {"--no-point-means", "--no-point-means: "}}) {
+        const Result r = Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " " + flag);
+        EXPECT_EQ(r.code, 2) << flag << ": " << r.out;  // a usage error
+        EXPECT_NE(r.out.find(named), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find(f.map.string()), std::string::npos) << r.out;
+    }
+    EXPECT_NE(Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " --max-range 40").out.find(
+                  "built with --max-range 30"),
+              std::string::npos);
+    EXPECT_EQ(MapFiles(f.map), files_before);
+    EXPECT_EQ(SessionCount(f.map), 1u);
+    const Result same = Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " --max-range 30");
+    EXPECT_EQ(same.code, 0) << same.out;
+    const Result none = Strata(Join(IntegrateArgs(f.map, f.seq, 3)));
+    EXPECT_EQ(none.code, 0) << none.out;
+    EXPECT_NE(none.out.find("range [0, 30] m"), std::string::npos) << none.out;
+    EXPECT_EQ(OpenForReading(f.map).settings().integration.max_range_m, 30.0);
+}
+
+// History you can drop: `gc --keep-last` keeps the newest snapshots, `info --json` reports the
+// bytes by kind before and after, `--as-of` an older session is refused saying why, and the
+// session's layers still serve `diff`.
+TEST(StoreFaults, GcKeepLastDropsOldHistoryAndInfoShowsTheBytes) {
+    const Fixture f = MakeMap("faults_history", 4);
+    const nlohmann::json before = JsonIn(Strata("info " + f.map.string() + " --json").out);
+    ASSERT_TRUE(before.contains("bytes")) << before.dump();
+    const nlohmann::json& b = before["bytes"];
+    EXPECT_GT(b["fused_current"].get<uint64_t>(), 0u);
+    EXPECT_GT(b["fused_older"].get<uint64_t>(), 0u);
+    EXPECT_GT(b["layers"].get<uint64_t>(), 0u);
+    EXPECT_EQ(b["products"].get<uint64_t>(), 0u);
+    EXPECT_EQ(before["history_start_commit"].get<int64_t>(), 1);
+    const Result bad = Strata("gc " + f.map.string() + " --keep-last 2 --keep-since 2024-01-01");
+    EXPECT_EQ(bad.code, 2) << bad.out;
+    EXPECT_NE(bad.out.find("exactly one"), std::string::npos) << bad.out;
+    const Result gc = Strata("gc " + f.map.string() + " --keep-last 1");
+    ASSERT_EQ(gc.code, 0) << gc.out;
+    EXPECT_NE(gc.out.find("history kept from commit 5"), std::string::npos) << gc.out;
+    const nlohmann::json after = JsonIn(Strata("info " + f.map.string() + " --json").out);
+    EXPECT_EQ(after["bytes"]["fused_older"].get<uint64_t>(), 0u);
+    EXPECT_EQ(after["bytes"]["layers"], b["layers"]);
+    EXPECT_EQ(after["occupied_voxels"], before["occupied_voxels"]);
+    EXPECT_LT(after["disk_bytes"].get<uint64_t>(), before["disk_bytes"].get<uint64_t>());
+    const Result as_of = Strata("info " + f.map.string() + " --as-of 1");
+    EXPECT_EQ(as_of.code, 5) << as_of.out;  // not found: no longer kept
+    EXPECT_NE(as_of.out.find("no longer kept"), std::string::npos) << as_of.out;
+    const Result diff = Strata("diff " + f.map.string() + " --from 1 --to 4 --json");
+    EXPECT_EQ(diff.code, 0) << diff.out;
+    EXPECT_EQ(Strata("check " + f.map.string()).code, 0);
+}
+
+// `strata upgrade` says what it did, and that a current map needs nothing.
+TEST(StoreFaults, UpgradeSaysWhatItDid) {
+    const Fixture f = MakeMap("faults_upgrade", 2);
+    const Result current = Strata("upgrade " + f.map.string());
+    EXPECT_EQ(current.code, 0) << current.out;
+    EXPECT_NE(current.out.find("format 5 already"), std::string::npos) << current.out;
+    strata::test::RewriteAsFormat4(f.map);
+    const Result info = Strata("info " + f.map.string());
+    EXPECT_EQ(info.code, 6) << info.out;  // bad format: says how to upgrade
+    EXPECT_NE(info.out.find("strata upgrade " + f.map.string()), std::string::npos) << info.out;
+    const Result upgrade = Strata("upgrade " + f.map.string());
+    EXPECT_EQ(upgrade.code, 0) << upgrade.out;
+    EXPECT_NE(upgrade.out.find("format 4 -> 5"), std::string::npos) << upgrade.out;
+    EXPECT_EQ(Strata("check " + f.map.string()).code, 0);
+    EXPECT_EQ(SessionCount(f.map), 2u);
 }
 
 }  // namespace
