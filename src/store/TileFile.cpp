@@ -39,6 +39,34 @@ std::string KeyText(const TileKey& key) {
     return std::to_string(key.x) + "_" + std::to_string(key.y);
 }
 
+// Stream buffers over a std::string without copying it (std::stringstream copies the bytes in
+// and, before C++20, out again: a tile read or write paid for two extra copies of the file).
+class StringSource : public std::streambuf {
+public:
+    explicit StringSource(const std::string& bytes) {
+        char* begin = const_cast<char*>(bytes.data());  // read only: the get area never writes
+        setg(begin, begin, begin + bytes.size());
+    }
+};
+
+class StringSink : public std::streambuf {
+public:
+    explicit StringSink(std::string& out) : out_(out) {}
+
+protected:
+    int_type overflow(int_type c) override {
+        if (!traits_type::eq_int_type(c, traits_type::eof())) out_.push_back(static_cast<char>(c));
+        return traits_type::not_eof(c);
+    }
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        out_.append(s, static_cast<size_t>(n));
+        return n;
+    }
+
+private:
+    std::string& out_;
+};
+
 void Count(FileKind kind, uint64_t bytes) {
     (kind == FileKind::kFused    ? g_fused_bytes
      : kind == FileKind::kLayers ? g_layer_bytes
@@ -84,15 +112,15 @@ uint64_t Checksum(const std::string& bytes) { return XXH64(bytes.data(), bytes.s
 EncodedFile EncodeGrids(const openvdb::GridPtrVec& grids, const TileKey& key) {
     openvdb::MetaMap meta;
     meta.insertMeta(kTileKeyMeta, openvdb::StringMetadata(KeyText(key)));
-    std::ostringstream os(std::ios::binary);
+    EncodedFile out;
+    StringSink sink(out.bytes);
+    std::ostream os(&sink);
     openvdb::io::Stream stream(os);
     // Active-mask compression only: Blosc made files 1.7x smaller but cost 5-7 points of the
     // commit overhead and a third of a tile read's time (docs/bench.md, Store).
     stream.setCompression(openvdb::io::COMPRESS_ACTIVE_MASK);
     stream.write(grids, meta);
     if (!os) throw IoError("tile " + KeyText(key) + ": cannot serialise");
-    EncodedFile out;
-    out.bytes = std::move(os).str();
     out.checksum = Checksum(out.bytes);
     return out;
 }
@@ -151,7 +179,8 @@ openvdb::GridPtrVec DecodeGrids(const std::string& bytes, const TileKey& key,
     openvdb::GridPtrVecPtr grids;
     openvdb::MetaMap::Ptr meta;
     try {
-        std::istringstream is(bytes, std::ios::binary);
+        StringSource source(bytes);
+        std::istream is(&source);
         // Delayed loading copies the stream to a temporary file under /tmp (left behind when the
         // process is killed) and gave inactive voxels arbitrary values, which the integrator then
         // added to when it activated them.
