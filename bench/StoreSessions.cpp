@@ -59,7 +59,6 @@ struct Commit {
     double cpu_s = 0.0;
     double commit_s = 0.0;
     uint64_t disk = 0;
-    double open_s = 0.0;  // open the map and load the current fused map whole
 };
 
 Commit OneSession(MapStore& map, const std::vector<core::Scan>& scans) {

@@ -75,7 +75,7 @@ std::vector<ProductRow> SelectRows(const detail::Database& db, const char* sql,
     Statement q(db, sql);
     q.Bind(1, kind);
     std::vector<ProductRow> out;
-    while (q.Step()) out.push_back({q.Int(0), q.Int(1), q.Text(2)});
+    while (q.Step()) out.push_back({q.Int(0), q.Int(1), q.Text(2), q.Text(3)});
     return out;
 }
 
@@ -175,14 +175,16 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
 
 std::vector<ProductRow> MapStore::ProductRows(const std::string& kind) const {
     return SelectRows(*impl_->db,
-                      "SELECT id, commit_id, row FROM product_rows WHERE kind = ?1 AND "
-                      "commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1) ORDER BY id",
+                      "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
+                      "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
+                      "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1) ORDER BY r.id",
                       kind);
 }
 
 std::vector<ProductRow> MapStore::ProductHistory(const std::string& kind) const {
     return SelectRows(*impl_->db,
-                      "SELECT id, commit_id, row FROM product_rows WHERE kind = ?1 ORDER BY id",
+                      "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
+                      "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 ORDER BY r.id",
                       kind);
 }
 

@@ -89,7 +89,8 @@ void List(const DiffArgs& args) {
                               " is damaged");
         }
         // The list keeps the keys it always had: the view's from_side/to_side as from/to.
-        nlohmann::json entry = {{"id", row.id}, {"commit", row.commit}};
+        nlohmann::json entry = {{"id", row.id}, {"commit", row.commit},
+                                {"created_utc", row.time_utc}};
         for (const auto& [key, value] : j.items()) {
             entry[key == "from_side" ? "from" : key == "to_side" ? "to" : key] = value;
         }
@@ -177,8 +178,7 @@ void Run(const DiffArgs& args) {
     if (args.save) {
         store::ProductCommit product;
         product.kind = "change_sets";
-        product.rows.push_back(nlohmann::json{{"created_utc", UtcNow()},
-                                              {"from_side", a.name},
+        product.rows.push_back(nlohmann::json{{"from_side", a.name},
                                               {"to_side", b.name},
                                               {"added_voxels", changes.added_voxels_total},
                                               {"removed_voxels", changes.removed_voxels_total},

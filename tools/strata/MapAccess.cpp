@@ -1,7 +1,6 @@
 #include "MapAccess.hpp"
 
 #include <cstdlib>
-#include <ctime>
 #include <stdexcept>
 
 #include "strata/core/Error.hpp"
@@ -30,15 +29,6 @@ store::MapStore OpenMap(const fs::path& dir, store::MapStore::Access access) {
 
 store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of) {
     return as_of.empty() ? map.Latest() : map.AsOf(map.FindSession(as_of));
-}
-
-std::string UtcNow() {
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&now, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
 }
 
 void WriteTextFile(const std::string& path, const std::string& text) {

@@ -21,9 +21,6 @@ namespace strata::tools {
 /// or a name) when given.
 [[nodiscard]] store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of);
 
-/// The current UTC time, ISO 8601 to the second ("2024-06-01T12:00:00Z").
-[[nodiscard]] std::string UtcNow();
-
 /// Writes a text file all or nothing (io::WriteFileAtomically: temporary file, fsync, rename).
 void WriteTextFile(const std::string& path, const std::string& text);
 /// Writes grids to a .vdb file.
