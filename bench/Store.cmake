@@ -4,7 +4,7 @@ add_executable(bench_store ${CMAKE_CURRENT_LIST_DIR}/bench_store.cpp
   ${CMAKE_CURRENT_LIST_DIR}/StoreSessions.cpp ${PROJECT_SOURCE_DIR}/tests/support/Format4Map.cpp)
 target_link_libraries(bench_store PRIVATE Strata::store Strata::io strata_test_support TBB::tbb
   SQLite::SQLite3 PkgConfig::XXHASH)
-target_compile_definitions(bench_store PRIVATE STRATA_DATA_DIR="${STRATA_DATA_DIR}")
+strata_use_build_paths(bench_store)
 strata_set_warnings(bench_store)
 # The short run checks the targets in CI (about 1-2 minutes on 2 cores); the full run writes
 # docs/bench.md (bench/run_benchmarks.sh).
