@@ -151,15 +151,20 @@ TEST(ViewService, ADiffBetweenSessionsIsWhatStrataDiffReportsAndHoldsTheCrate) {
 
 TEST(ViewService, ASavedChangeSetIsRebuiltWhenItsSidesAreSessionsAndOnlyThen) {
     const auto service = Service(Map().dir);
-    const json between = Get(*service, "/api/changeset/1");
+    // Change set ids are product row ids, unique in the map (the wall row came first).
+    const json sets = Get(*service, "/api/map")["change_sets"];
+    ASSERT_EQ(sets.size(), 2u);
+    const std::string first = std::to_string(sets[0]["id"].get<int64_t>());
+    const std::string second = std::to_string(sets[1]["id"].get<int64_t>());
+    const json between = Get(*service, "/api/changeset/" + first);
     EXPECT_TRUE(between["voxels"].get<bool>());
     EXPECT_EQ(between["record"]["to"], "session 2");
     EXPECT_FALSE(between["tiles"].empty());
-    const json scans = Get(*service, "/api/changeset/2");
+    const json scans = Get(*service, "/api/changeset/" + second);
     EXPECT_FALSE(scans["voxels"].get<bool>());
     EXPECT_TRUE(scans["tiles"].empty());
-    EXPECT_EQ(service->Get("/api/changeset/2/0/0/0").status, 404);
-    EXPECT_EQ(service->Get("/api/changeset/7").status, 404);
+    EXPECT_EQ(service->Get("/api/changeset/" + second + "/0/0/0").status, 404);
+    EXPECT_EQ(service->Get("/api/changeset/999").status, 404);
 }
 
 TEST(ViewService, AVoxelRecordHoldsEveryValueAndTheWallRowItBelongsTo) {
