@@ -14,8 +14,8 @@
 
 namespace strata::io::detail {
 
-/// @brief Reads a file (at most its first `max_bytes`) into memory; throws std::runtime_error
-/// naming it on failure. `file_size`, when given, receives the size of the whole file.
+/// @brief Reads a file (at most its first `max_bytes`) into memory; throws NotFoundError,
+/// IoError or FormatError (a directory) naming it on failure. `file_size`, when given, receives the size of the whole file.
 [[nodiscard]] std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path,
                                                  size_t max_bytes = SIZE_MAX,
                                                  size_t* file_size = nullptr);

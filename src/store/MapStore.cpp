@@ -300,7 +300,7 @@ int64_t MapStore::FindSession(const std::string& id_or_name) const {
     for (const auto& [s, removed] : history) {
         known += (known.empty() ? "" : ", ") + std::to_string(s.id) + " " + s.name;
     }
-    throw std::runtime_error(impl_->dir.string() + ": no session '" + id_or_name +
+    throw NotFoundError(impl_->dir.string() + ": no session '" + id_or_name +
                              "' (sessions: " + (known.empty() ? "none" : known) + ")");
 }
 
