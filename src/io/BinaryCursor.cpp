@@ -1,24 +1,20 @@
 #include "BinaryCursor.hpp"
 
-#include <algorithm>
-#include <fstream>
-#include <system_error>
-
+#include "TextParsing.hpp"
 #include "strata/core/Error.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <fstream>
 
 namespace strata::io::detail {
 
 std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path, size_t max_bytes,
                                    size_t* file_size) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
-        throw FormatError(path.string() + ": is a directory, expected a file");
-    }
+    RequireFile(path);
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        if (!std::filesystem::exists(path, ec)) throw NotFoundError(path.string() + ": no such file");
-        throw IoError(path.string() + ": cannot open file for reading");
-    }
+    if (!in) FailOpen(path);
     in.seekg(0, std::ios::end);
     const std::streamoff size = in.tellg();
     if (size < 0) throw IoError(path.string() + ": cannot determine the file size");
