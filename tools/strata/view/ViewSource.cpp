@@ -17,12 +17,21 @@
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::view {
+
+// A saved change set (`strata diff --save`, tools/strata/Diff.cpp): its sides and counts. Not in
+// the anonymous namespace: ViewSource::Impl holds them.
+struct ChangeSetRow {
+    int64_t id = 0;
+    int64_t commit = 0;
+    std::string from, to;
+    size_t added_voxels = 0, removed_voxels = 0, objects = 0;
+    nlohmann::json report;
+};
+
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-json Vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 
 json SessionJson(const store::SessionRecord& s, int64_t removed_by) {
     json alignment = json::array();
@@ -78,15 +87,6 @@ json VehicleJson(const json& v, int64_t commit) {
             {"refilled_cells", v.value("refilled_cells", 0)},
             {"refused_cells", v.value("refused_cells", 0)}};
 }
-
-// A saved change set (`strata diff --save`, tools/strata/Diff.cpp): its sides and counts.
-struct ChangeSetRow {
-    int64_t id = 0;
-    int64_t commit = 0;
-    std::string from, to;
-    size_t added_voxels = 0, removed_voxels = 0, objects = 0;
-    json report;
-};
 
 ChangeSetRow ChangeSetOf(const json& j, const store::ProductRow& r) {
     ChangeSetRow c;
