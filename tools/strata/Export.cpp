@@ -5,10 +5,7 @@
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
-#include "strata/io/OctomapExport.hpp"
-#include "strata/io/PlyExport.hpp"
-#include "strata/io/PngExport.hpp"
-#include "strata/io/VdbExport.hpp"
+#include "strata/pipeline/Export.hpp"
 
 namespace strata::tools {
 
@@ -24,37 +21,13 @@ struct ExportArgs {
 };
 
 void Run(const ExportArgs& args) {
-    std::string format = args.format;
-    if (format.empty()) {
-        const std::string ext = std::filesystem::path(args.out).extension().string();
-        if (ext.size() < 2) {
-            throw std::invalid_argument("--out " + args.out + ": no extension; give --format");
-        }
-        format = ext.substr(1);
-    }
+    pipeline::ExportOptions options;
+    options.format = args.format;
+    options.pixels_per_voxel = args.pixels_per_voxel;
+    options.color = args.color;
+    (void)pipeline::ExportFormat(args.out, options);  // a bad name fails before the map is read
     const store::MapStore store = OpenMap(args.map);
-    const core::VoxelMap map = store.LoadMap(SelectSnapshot(store, args.as_of));
-    if (format == "vdb") {
-        io::WriteVdb(map, args.out);
-    } else if (format == "bt" || format == "ot") {
-        if (std::filesystem::path(args.out).extension() != "." + format) {
-            throw std::invalid_argument("--out " + args.out + ": OctoMap files must end in ." +
-                                        format);
-        }
-        io::WriteOctomap(map, args.out);
-    } else if (format == "ply") {
-        io::WritePly(map, args.out);
-    } else if (format == "png") {
-        io::TopDownOptions options;
-        options.pixels_per_voxel = args.pixels_per_voxel;
-        // Unlabelled maps carry no class colours: show heights instead.
-        options.color_by_height = args.color == "height" ||
-                                  (args.color == "auto" && map.label->activeVoxelCount() == 0);
-        io::WriteTopDownPng(map, args.out, options);
-    } else {
-        throw std::invalid_argument("unknown export format '" + format +
-                                    "' (use vdb, bt, ot, ply or png)");
-    }
+    pipeline::ExportMap(store.LoadMap(SelectSnapshot(store, args.as_of)), args.out, options);
     std::cout << "wrote " << args.out << " (" << std::filesystem::file_size(args.out)
               << " bytes)\n";
 }
