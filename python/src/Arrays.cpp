@@ -69,9 +69,10 @@ Eigen::Isometry3d PoseFromArray(const py::array& pose, const char* name) {
     const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
     const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (error > kOrthonormalTolerance || R.determinant() < 0.0) {
-        throw InvalidArgumentError(what + ": the rotation part is not orthonormal with "
-                                   "determinant +1 (max |R^T R - I| = " + std::to_string(error) +
-                                   ")");
+        throw InvalidArgumentError(what +
+                                   ": the rotation part is not orthonormal with "
+                                   "determinant +1 (max |R^T R - I| = " +
+                                   std::to_string(error) + ")");
     }
     if ((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 0.0) {
         throw InvalidArgumentError(what + ": the last row must be 0 0 0 1");
@@ -96,16 +97,16 @@ std::vector<uint32_t> IdsFromArray(const py::array& ids, size_t count, const cha
     for (size_t i = 0; i < count; ++i) {
         const int64_t id = v(static_cast<py::ssize_t>(i));
         if (id < 0 || id > int64_t{0xFFFFFFFF}) {
-            throw InvalidArgumentError(what + "[" + std::to_string(i) + "] = " +
-                                       std::to_string(id) + " is not a label id");
+            throw InvalidArgumentError(what + "[" + std::to_string(i) +
+                                       "] = " + std::to_string(id) + " is not a label id");
         }
         out[i] = static_cast<uint32_t>(id);
     }
     return out;
 }
 
-core::Scan ScanFromArrays(const py::array& points, const py::array& pose,
-                          const py::object& labels, const py::object& classes) {
+core::Scan ScanFromArrays(const py::array& points, const py::array& pose, const py::object& labels,
+                          const py::object& classes) {
     core::Scan scan;
     scan.points = PointsFromArray(points);
     scan.T_world_sensor = PoseFromArray(pose);
@@ -130,9 +131,9 @@ core::Scan ScanFromArrays(const py::array& points, const py::array& pose,
         scan.labels.reserve(ids.size());
         for (size_t i = 0; i < ids.size(); ++i) {
             if (ids[i] >= static_cast<uint32_t>(core::kNumClasses)) {
-                throw InvalidArgumentError("classes[" + std::to_string(i) + "] = " +
-                                           std::to_string(ids[i]) + " is not a strata class (0.." +
-                                           std::to_string(core::kNumClasses - 1) + ")");
+                throw InvalidArgumentError(
+                    "classes[" + std::to_string(i) + "] = " + std::to_string(ids[i]) +
+                    " is not a strata class (0.." + std::to_string(core::kNumClasses - 1) + ")");
             }
             scan.labels.push_back(static_cast<core::SemanticClass>(ids[i]));
         }

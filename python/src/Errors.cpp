@@ -51,8 +51,7 @@ void RegisterErrors(py::module_& m) {
                         "Another process writes the map; retrying later can succeed.");
     c.refused = NewError(m, "RefusedError", py::make_tuple(c.base),
                          "The operation ran and declined its result; nothing was changed.");
-    c.io = NewError(m, "IoError", both("OSError"),
-                    "The operating system failed a read or write.");
+    c.io = NewError(m, "IoError", both("OSError"), "The operating system failed a read or write.");
 
     py::register_exception_translator([](std::exception_ptr p) {
         const ErrorClasses& k = Classes();

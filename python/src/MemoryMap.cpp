@@ -1,5 +1,7 @@
 #include "MemoryMap.hpp"
 
+#include <pybind11/stl/filesystem.h>
+
 #include "Queries.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
@@ -9,8 +11,8 @@ namespace strata::python {
 
 namespace {
 
-MemoryMap Create(double voxel, double max_range, double min_range, bool points_only,
-                 bool keep_point_means) {
+MemoryMap CreateMemoryMap(double voxel, double max_range, double min_range, bool points_only,
+                          bool keep_point_means) {
     MemoryMap m;
     m.config.max_range_m = max_range;
     m.config.min_range_m = min_range;
@@ -22,11 +24,12 @@ MemoryMap Create(double voxel, double max_range, double min_range, bool points_o
     return m;
 }
 
-py::dict Integrate(MemoryMap& m, const py::array& points, const py::array& pose,
-                   const py::object& labels, const py::object& classes) {
+py::dict IntegrateInMemory(MemoryMap& m, const py::array& points, const py::array& pose,
+                           const py::object& labels, const py::object& classes) {
     if (m.read_only) {
-        throw InvalidArgumentError("this VoxelMap is a stored map's snapshot; integrate through "
-                                   "Map.session() instead");
+        throw InvalidArgumentError(
+            "this VoxelMap is a stored map's snapshot; integrate through "
+            "Map.session() instead");
     }
     const core::Scan scan = ScanFromArrays(points, pose, labels, classes);
     integration::ScanUpdate update;
@@ -38,8 +41,8 @@ py::dict Integrate(MemoryMap& m, const py::array& points, const py::array& pose,
     return UpdateCounts(update.points, update.dropped, update.clipped);
 }
 
-std::string Export(const MemoryMap& m, const std::string& path, const std::string& format,
-                   const std::string& color) {
+std::string ExportMemoryMap(const MemoryMap& m, const std::filesystem::path& path,
+                            const std::string& format, const std::string& color) {
     pipeline::ExportOptions options;
     options.format = format;
     options.color = color;
@@ -62,11 +65,11 @@ void RegisterMemoryMap(py::module_& m) {
 A map held in memory: scans integrated from numpy arrays with OctoMap's occupancy rule
 (docs/integration.md), queried and exported without a store on disk. Stored maps
 (strata.Map) hand out their snapshots as read-only VoxelMaps.)doc")
-        .def(py::init(&Create), py::arg("voxel") = 0.2, py::arg("max_range") = 50.0,
+        .def(py::init(&CreateMemoryMap), py::arg("voxel") = 0.2, py::arg("max_range") = 50.0,
              py::arg("min_range") = 0.0, py::arg("points_only") = false,
              py::arg("keep_point_means") = true,
              "An empty map with cubic voxels of `voxel` metres.")
-        .def("integrate", &Integrate, py::arg("points"), py::arg("pose"),
+        .def("integrate", &IntegrateInMemory, py::arg("points"), py::arg("pose"),
              py::arg("labels") = py::none(), py::arg("classes") = py::none(),
              R"doc(Integrates one scan.
 
@@ -75,29 +78,33 @@ pose: (4, 4) or (3, 4) sensor-to-map transform.
 labels: optional (N,) SemanticKITTI ids (class | instance << 16); or
 classes: optional (N,) strata class ids (strata.CLASSES).
 Returns {"points", "dropped", "clipped"} counts.)doc")
-        .def("occupancy", [](const MemoryMap& self, const py::array& p) {
-                 return QueryOccupancy(*self.map, p);
-             }, py::arg("points"),
-             "State (-1 unknown, 0 free, 1 occupied), log_odds, label and hits at (N, 3) "
-             "map-frame points.")
-        .def("voxels", [](const MemoryMap& self, const py::object& lo, const py::object& hi,
-                          bool occupied_only) { return QueryBox(*self.map, lo, hi, occupied_only); },
-             py::arg("lo"), py::arg("hi"), py::arg("occupied_only") = false,
-             "Observed voxels whose centres lie in the box [lo, hi]: ijk, center, log_odds, "
-             "label, label_weight, hits (one row per voxel).")
-        .def("columns", [](const MemoryMap& self, int window) {
-                 return QueryColumns(*self.map, window);
-             }, py::arg("window") = 0,
-             "Column statistics as 2D arrays [row j, column i]: points, voxels, z_min, z_max, "
-             "extent, classes (rows, cols, len(strata.CLASSES)); x0, y0, cell place them.")
-        .def("info", [](const MemoryMap& self) { return DescribeMap(*self.map); },
-             "Voxel size, origin and voxel counts.")
-        .def("export", &Export, py::arg("path"), py::arg("format") = "",
+        .def(
+            "occupancy",
+            [](const MemoryMap& self, const py::array& p) { return QueryOccupancy(*self.map, p); },
+            py::arg("points"),
+            "State (-1 unknown, 0 free, 1 occupied), log_odds, label and hits at (N, 3) "
+            "map-frame points.")
+        .def(
+            "voxels",
+            [](const MemoryMap& self, const py::object& lo, const py::object& hi,
+               bool occupied_only) { return QueryBox(*self.map, lo, hi, occupied_only); },
+            py::arg("lo"), py::arg("hi"), py::arg("occupied_only") = false,
+            "Observed voxels whose centres lie in the box [lo, hi]: ijk, center, log_odds, "
+            "label, label_weight, hits (one row per voxel).")
+        .def(
+            "columns",
+            [](const MemoryMap& self, int window) { return QueryColumns(*self.map, window); },
+            py::arg("window") = 0,
+            "Column statistics as 2D arrays [row j, column i]: points, voxels, z_min, z_max, "
+            "extent, classes (rows, cols, len(strata.CLASSES)); x0, y0, cell place them.")
+        .def(
+            "info", [](const MemoryMap& self) { return DescribeMap(*self.map); },
+            "Voxel size, origin and voxel counts.")
+        .def("export", &ExportMemoryMap, py::arg("path"), py::arg("format") = "",
              py::arg("color") = "auto",
              "Writes the map for viewers: vdb, bt, ot, ply or png (default: from the name).")
-        .def_property_readonly("voxel_size", [](const MemoryMap& self) {
-            return self.map->voxel_size;
-        });
+        .def_property_readonly("voxel_size",
+                               [](const MemoryMap& self) { return self.map->voxel_size; });
 }
 
 }  // namespace strata::python

@@ -12,6 +12,7 @@ PYBIND11_MODULE(_strata, m) {
     python::RegisterReaders(m);
     python::RegisterSimulation(m);
     python::RegisterMemoryMap(m);
+    python::RegisterStoredMap(m);
     pybind11::list classes;
     for (int k = 0; k < strata::core::kNumClasses; ++k) {
         classes.append(strata::core::ClassName(static_cast<strata::core::SemanticClass>(k)));

@@ -65,9 +65,8 @@ py::dict QueryBox(const core::VoxelMap& map, const py::object& lo, const py::obj
         const double s = map.voxel_size;
         const auto first = [s](double v) { return static_cast<int>(std::ceil(v / s - 0.5)); };
         const auto last = [s](double v) { return static_cast<int>(std::floor(v / s - 0.5)); };
-        const openvdb::CoordBBox box(
-            openvdb::Coord(first(min.x()), first(min.y()), first(min.z())),
-            openvdb::Coord(last(max.x()), last(max.y()), last(max.z())));
+        const openvdb::CoordBBox box(openvdb::Coord(first(min.x()), first(min.y()), first(min.z())),
+                                     openvdb::Coord(last(max.x()), last(max.y()), last(max.z())));
         const auto labels = map.label->getConstAccessor();
         const auto weights = map.label_weight->getConstAccessor();
         const auto counts = map.hits->getConstAccessor();

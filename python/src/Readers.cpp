@@ -23,17 +23,16 @@ py::dict ScanToDict(core::Scan&& scan) {
     const auto n = static_cast<py::ssize_t>(scan.points.size());
     if (scan.has_labels()) {
         std::vector<uint8_t> classes(scan.labels.size());
-        for (size_t i = 0; i < classes.size(); ++i) classes[i] = static_cast<uint8_t>(scan.labels[i]);
+        for (size_t i = 0; i < classes.size(); ++i)
+            classes[i] = static_cast<uint8_t>(scan.labels[i]);
         out["classes"] = ToArray(std::move(classes), {n});
     } else {
         out["classes"] = py::none();
     }
-    out["instances"] = scan.instances.empty()
-                           ? py::object(py::none())
-                           : py::object(ToArray(std::move(scan.instances), {n}));
-    out["intensity"] = scan.intensity.empty()
-                           ? py::object(py::none())
-                           : py::object(ToArray(std::move(scan.intensity), {n}));
+    out["instances"] = scan.instances.empty() ? py::object(py::none())
+                                              : py::object(ToArray(std::move(scan.instances), {n}));
+    out["intensity"] = scan.intensity.empty() ? py::object(py::none())
+                                              : py::object(ToArray(std::move(scan.intensity), {n}));
     out["pose"] = MatrixToArray(scan.T_world_sensor.matrix());
     out["time"] = scan.time_s;
     return out;

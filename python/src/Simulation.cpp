@@ -2,10 +2,10 @@
 // Each scan is what `strata simulate` would write for it: float32 points in the sensor frame,
 // SemanticKITTI labels, the pose in the session's frame; so a map integrated from these arrays
 // equals `strata integrate` on the written sequence.
+#include <pybind11/stl.h>
+
 #include <memory>
 #include <optional>
-
-#include <pybind11/stl.h>
 
 #include "Arrays.hpp"
 #include "Bindings.hpp"
@@ -69,7 +69,8 @@ public:
                 points[3 * i + static_cast<size_t>(a)] = static_cast<float>(scan.scan.points[i][a]);
             }
         }
-        for (size_t i = 0; i < classes.size(); ++i) classes[i] = static_cast<uint8_t>(scan.scan.labels[i]);
+        for (size_t i = 0; i < classes.size(); ++i)
+            classes[i] = static_cast<uint8_t>(scan.scan.labels[i]);
         const Eigen::Isometry3d T_session_sensor =
             spec_.sessions[session_].T_world_session.inverse() * poses_[k].T_world_sensor;
         py::dict out;

@@ -14,8 +14,8 @@ from . import _strata
 from ._strata import (CLASSES, Error, FormatError, InvalidArgumentError, IoError,
                       MapLockedError, NotFoundError, RefusedError, VoxelMap)
 
-__all__ = ["CLASSES", "Error", "FormatError", "InvalidArgumentError", "IoError",
-           "MapLockedError", "NotFoundError", "RefusedError", "Scan", "VoxelMap",
+__all__ = ["CLASSES", "Error", "FormatError", "InvalidArgumentError", "IoError", "Map",
+           "MapLockedError", "NotFoundError", "RefusedError", "Scan", "Session", "VoxelMap",
            "read_kitti", "read_points", "simulate"]
 
 
@@ -72,3 +72,131 @@ def simulate(scene="demo", session: int = 0, sensor: Optional[str] = None,
         d = sim.scan(k)
         yield Scan(points=d["points"], pose=d["pose"], labels=d["labels"],
                    classes=d["classes"], time=d["time"])
+
+
+class Session:
+    """One session being added to a Map: integrate scans, then commit them all at once.
+
+    Used as `with map.session("name") as s: s.integrate(points, pose)`, it commits when the
+    block ends and, when the block raises, removes what it wrote: the map is as before.
+    """
+
+    def __init__(self, map: "Map", name: str = "", memory_budget_mb: float = 0.0):
+        self._map = map
+        self._impl = _strata._Session(map._impl, name, memory_budget_mb)
+
+    def integrate(self, points, pose, labels=None, classes=None) -> dict:
+        """Integrates one scan (see VoxelMap.integrate for the arrays); nothing reaches the
+        map on disk before commit(). Returns {"points", "dropped", "clipped"}."""
+        return self._impl.integrate(points, pose, labels, classes)
+
+    def commit(self) -> dict:
+        """Writes the session in one transaction; returns its record (as Map.sessions())."""
+        record = self._impl.commit()
+        self._map._newest = None
+        return record
+
+    def abort(self) -> None:
+        """Drops everything this session wrote; the map on disk stays as it was."""
+        self._impl.abort()
+
+    @property
+    def record(self) -> Optional[dict]:
+        """The committed session's record, None before commit."""
+        return self._impl.record
+
+    def __enter__(self) -> "Session":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.abort()
+        return False
+
+
+class Map:
+    """A map on disk: a transactional store of sessions (docs/store.md).
+
+    Create one with Map.create, open one with Map.open; add scans in sessions; query the newest
+    state (occupancy, voxels, columns) or any session's (as_of); export for viewers. A Map
+    opened for writing holds the map's writer lock until close() (or the end of a `with`).
+    """
+
+    def __init__(self, impl):
+        self._impl = impl
+        self._newest = None
+
+    @staticmethod
+    def create(path, voxel: float = 0.2, tile_size: float = 64.0, origin=None,
+               max_range: float = 50.0, min_range: float = 0.0, points_only: bool = False,
+               keep_point_means: bool = True) -> "Map":
+        """Creates an empty map in `path` (absent or empty) and opens it for writing.
+
+        voxel and tile_size in metres; origin: the world position of map coordinate (0, 0, 0)
+        for georeferenced data; the integration rule as `strata integrate`'s options."""
+        return Map(_strata._Map.create(str(path), voxel, tile_size, origin, max_range,
+                                       min_range, points_only, keep_point_means))
+
+    @staticmethod
+    def open(path, read_only: bool = False) -> "Map":
+        """Opens the map in `path`; for writing (the default) it takes the writer lock
+        (MapLockedError when another process holds it)."""
+        return Map(_strata._Map.open(str(path), read_only))
+
+    def close(self) -> None:
+        """Releases the map (and its writer lock)."""
+        self._impl.close()
+        self._newest = None
+
+    def __enter__(self) -> "Map":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        self.close()
+        return False
+
+    @property
+    def path(self) -> str:
+        return self._impl.path
+
+    @property
+    def voxel_size(self) -> float:
+        return self._impl.voxel_size
+
+    def session(self, name: str = "", memory_budget_mb: float = 0.0) -> Session:
+        """A new session named `name` (default session_<id>); use it in a `with` block.
+        memory_budget_mb > 0 keeps at most that many MB of tiles in memory."""
+        return Session(self, name, memory_budget_mb)
+
+    def sessions(self) -> list:
+        """The map's sessions, oldest first, as dicts (id, name, scans, points, ...)."""
+        return self._impl.sessions()
+
+    def as_of(self, session) -> VoxelMap:
+        """The map right after `session` (an id or a name) was committed, read-only."""
+        return self._impl.load(str(session))
+
+    def snapshot(self) -> VoxelMap:
+        """The newest state as a read-only VoxelMap (read once, until the next commit)."""
+        if self._newest is None:
+            self._newest = self._impl.load("")
+        return self._newest
+
+    def occupancy(self, points) -> dict:
+        """VoxelMap.occupancy on the newest state."""
+        return self.snapshot().occupancy(points)
+
+    def voxels(self, lo, hi, occupied_only: bool = False) -> dict:
+        """VoxelMap.voxels on the newest state."""
+        return self.snapshot().voxels(lo, hi, occupied_only)
+
+    def columns(self, window: int = 0) -> dict:
+        """VoxelMap.columns on the newest state."""
+        return self.snapshot().columns(window)
+
+    def export(self, path, format: str = "", as_of=None) -> str:
+        """Writes the map (or its state as of a session) as vdb, bt, ot, ply or png
+        (default: from the file name); returns the format written."""
+        return self._impl.export(str(path), format, "" if as_of is None else str(as_of))

@@ -9,8 +9,8 @@
 namespace strata::pipeline {
 
 void ExportOptions::Validate() const {
-    if (!format.empty() && format != "vdb" && format != "bt" && format != "ot" &&
-        format != "ply" && format != "png") {
+    if (!format.empty() && format != "vdb" && format != "bt" && format != "ot" && format != "ply" &&
+        format != "png") {
         throw InvalidArgumentError("unknown export format '" + format +
                                    "' (use vdb, bt, ot, ply or png)");
     }

@@ -1,11 +1,12 @@
 // strata export: a map to the files viewers open (VDB, OctoMap .bt/.ot, PLY, PNG).
+#include "strata/pipeline/Export.hpp"
+
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
-#include "strata/pipeline/Export.hpp"
 
 namespace strata::tools {
 
@@ -36,7 +37,8 @@ void Run(const ExportArgs& args) {
 
 void RegisterExport(CLI::App& app) {
     auto args = std::make_shared<ExportArgs>();
-    CLI::App* cmd = app.add_subcommand("export", "Export a map for viewers (VDB, OctoMap, PLY, PNG)");
+    CLI::App* cmd =
+        app.add_subcommand("export", "Export a map for viewers (VDB, OctoMap, PLY, PNG)");
     cmd->footer(
         "Examples:\n"
         "  strata export city.strata --out city.vdb          # vdb_print, vdb_view, Blender\n"
@@ -48,8 +50,9 @@ void RegisterExport(CLI::App& app) {
     cmd->add_option("--out", args->out, "Output file")->required();
     cmd->add_option("--pixels-per-voxel", args->pixels_per_voxel, "PNG scale")
         ->capture_default_str();
-    cmd->add_option("--color", args->color, "PNG colours: class, height, or auto (height when "
-                                            "the map has no labels)")
+    cmd->add_option("--color", args->color,
+                    "PNG colours: class, height, or auto (height when "
+                    "the map has no labels)")
         ->check(CLI::IsMember({"auto", "class", "height"}))
         ->capture_default_str();
     cmd->add_option("--as-of", args->as_of, "Export the map as it was right after this session");

@@ -1,0 +1,206 @@
+// strata.Map: a map on disk (the store, docs/store.md) and its sessions. Every call into the
+// store from Python is in this file, so a change of the store's API touches one place.
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+
+#include "Arrays.hpp"
+#include "Bindings.hpp"
+#include "MemoryMap.hpp"
+#include "Queries.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/pipeline/Export.hpp"
+#include "strata/pipeline/MapAccess.hpp"
+#include "strata/store/MapStore.hpp"
+#include "strata/store/SessionWriter.hpp"
+
+namespace strata::python {
+
+namespace {
+
+using store::MapStore;
+
+struct StoredMap {
+    std::shared_ptr<MapStore> store;  ///< null once closed
+    integration::IntegrationConfig config;
+
+    MapStore& Get() const {
+        if (!store) throw InvalidArgumentError("the map is closed");
+        return *store;
+    }
+    /// A snapshot as a read-only map in memory; `as_of` empty: the newest.
+    MemoryMap Load(const std::string& as_of) const {
+        MemoryMap m;
+        m.config = config;
+        m.read_only = true;
+        const MapStore& s = Get();
+        py::gil_scoped_release release;
+        m.map = std::make_shared<core::VoxelMap>(s.LoadMap(pipeline::SelectSnapshot(s, as_of)));
+        return m;
+    }
+};
+
+py::dict SessionDict(const store::SessionRecord& s) {
+    py::dict d;
+    d["id"] = s.id;
+    d["name"] = s.name;
+    d["source"] = s.source;
+    d["scans"] = s.scans;
+    d["points"] = s.points;
+    d["start_utc"] = s.start_utc;
+    d["end_utc"] = s.end_utc;
+    d["commit"] = s.commit;
+    d["alignment"] = MatrixToArray(s.alignment);
+    d["notes"] = s.notes;
+    return d;
+}
+
+StoredMap CreateStoredMap(const std::string& path, double voxel, double tile_size,
+                          const py::object& origin, double max_range, double min_range,
+                          bool points_only, bool keep_point_means) {
+    StoredMap m;
+    m.config.max_range_m = max_range;
+    m.config.min_range_m = min_range;
+    m.config.points_only = points_only;
+    m.config.keep_point_means = keep_point_means;
+    m.config.Validate();
+    store::StoreSettings settings;
+    settings.voxel_size_m = voxel;
+    settings.tile_size_m = tile_size;
+    if (!origin.is_none()) settings.origin = Vector3FromObject(origin, "origin");
+    if (MapStore::IsMap(path)) {
+        throw InvalidArgumentError(path + " holds a map already; open it with strata.Map.open");
+    }
+    py::gil_scoped_release release;
+    m.store = std::make_shared<MapStore>(MapStore::Create(path, settings));
+    return m;
+}
+
+StoredMap OpenStoredMap(const std::string& path, bool read_only) {
+    StoredMap m;
+    py::gil_scoped_release release;
+    m.store = std::make_shared<MapStore>(
+        pipeline::OpenMap(path, read_only ? MapStore::Access::kRead : MapStore::Access::kWrite));
+    return m;
+}
+
+py::list SessionList(const StoredMap& m) {
+    py::list out;
+    for (const store::SessionRecord& s : m.Get().Latest().sessions) out.append(SessionDict(s));
+    return out;
+}
+
+/// One session being written: scans go in through `integrate`; `commit` records them all in
+/// one transaction; `abort` (or an exception in a `with` block) leaves the map as it was.
+class Session {
+public:
+    Session(const StoredMap& map, const std::string& name, double memory_budget_mb)
+        : store_(map.store) {
+        if (!store_) throw InvalidArgumentError("the map is closed");
+        if (!store_->writable()) {
+            throw InvalidArgumentError(store_->dir().string() +
+                                       " is open read-only; open it with read_only=False to "
+                                       "add a session");
+        }
+        if (!(memory_budget_mb >= 0.0)) throw InvalidArgumentError("memory_budget_mb must be >= 0");
+        store::SessionOptions options;
+        options.name = name;
+        options.source = "python";
+        options.memory_budget_bytes = static_cast<size_t>(memory_budget_mb * 1e6);
+        writer_ = std::make_unique<store::SessionWriter>(*store_, map.config, options);
+    }
+
+    py::dict Integrate(const py::array& points, const py::array& pose, const py::object& labels,
+                       const py::object& classes) {
+        store::SessionWriter& writer = Writer();
+        const core::Scan scan = ScanFromArrays(points, pose, labels, classes);
+        integration::ScanUpdate update;
+        {
+            py::gil_scoped_release release;
+            update = writer.Integrate(scan);
+        }
+        return UpdateCounts(update.points, update.dropped, update.clipped);
+    }
+
+    py::dict Commit() {
+        store::SessionWriter& writer = Writer();
+        store::SessionRecord record;
+        {
+            py::gil_scoped_release release;
+            record = writer.Commit();
+        }
+        writer_.reset();
+        committed_ = SessionDict(record);
+        return *committed_;
+    }
+
+    void Abort() {
+        py::gil_scoped_release release;
+        writer_.reset();  // the writer removes the files it wrote; the catalog never saw them
+    }
+
+    [[nodiscard]] py::object Record() const {
+        return committed_ ? py::object(*committed_) : py::object(py::none());
+    }
+
+private:
+    store::SessionWriter& Writer() {
+        if (!writer_) throw InvalidArgumentError("the session is committed or aborted already");
+        return *writer_;
+    }
+
+    std::shared_ptr<MapStore> store_;  // the writer refers to it: kept alive with the session
+    std::unique_ptr<store::SessionWriter> writer_;
+    std::optional<py::dict> committed_;
+};
+
+}  // namespace
+
+void RegisterStoredMap(py::module_& m) {
+    py::class_<StoredMap>(m, "_Map")
+        .def_static("create", &CreateStoredMap, py::arg("path"), py::arg("voxel"),
+                    py::arg("tile_size"), py::arg("origin"), py::arg("max_range"),
+                    py::arg("min_range"), py::arg("points_only"), py::arg("keep_point_means"))
+        .def_static("open", &OpenStoredMap, py::arg("path"), py::arg("read_only"))
+        .def("close",
+             [](StoredMap& self) {
+                 py::gil_scoped_release release;
+                 self.store.reset();
+             })
+        .def("load", &StoredMap::Load, py::arg("as_of") = "")
+        .def("sessions", &SessionList)
+        .def("session_id",
+             [](const StoredMap& self, const std::string& id_or_name) {
+                 return self.Get().FindSession(id_or_name);
+             })
+        .def(
+            "export",
+            [](const StoredMap& self, const std::string& path, const std::string& format,
+               const std::string& as_of) {
+                pipeline::ExportOptions options;
+                options.format = format;
+                (void)pipeline::ExportFormat(path, options);  // a bad name fails before any read
+                const MemoryMap snapshot = self.Load(as_of);
+                py::gil_scoped_release release;
+                return pipeline::ExportMap(*snapshot.map, path, options);
+            },
+            py::arg("path"), py::arg("format") = "", py::arg("as_of") = "")
+        .def_property_readonly("path",
+                               [](const StoredMap& self) { return self.Get().dir().string(); })
+        .def_property_readonly("writable",
+                               [](const StoredMap& self) { return self.Get().writable(); })
+        .def_property_readonly(
+            "voxel_size", [](const StoredMap& self) { return self.Get().settings().voxel_size_m; });
+
+    py::class_<Session>(m, "_Session")
+        .def(py::init<const StoredMap&, const std::string&, double>(), py::arg("map"),
+             py::arg("name"), py::arg("memory_budget_mb") = 0.0)
+        .def("integrate", &Session::Integrate, py::arg("points"), py::arg("pose"),
+             py::arg("labels") = py::none(), py::arg("classes") = py::none())
+        .def("commit", &Session::Commit)
+        .def("abort", &Session::Abort)
+        .def_property_readonly("record", &Session::Record);
+}
+
+}  // namespace strata::python
