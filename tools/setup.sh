@@ -101,10 +101,13 @@ if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   "${sudo_cmd[@]}" mv "$tbb_source.partial" "$tbb_source"
 fi
 
-# The `strata` program and what it needs, in build/ as tools/test.sh configures it (same
-# settings, ccache), so the test command afterwards compiles only the rest.
+# The `strata` program, the Python module (when configured: python/CMakeLists.txt) and what
+# they need, in build/ as tools/test.sh configures it (same settings, ccache), so the test
+# command afterwards compiles only the rest.
 if ((build)); then
   root=$(cd "$(dirname "$0")/.." && pwd)
   "$root/tools/configure.sh"
-  cmake --build "$root/build" --target strata
+  targets=(strata)
+  [[ -d $root/build/python/strata ]] && targets+=(_strata)
+  cmake --build "$root/build" --target "${targets[@]}"
 fi

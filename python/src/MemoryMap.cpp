@@ -2,6 +2,7 @@
 
 #include <pybind11/stl/filesystem.h>
 
+#include "Analyses.hpp"
 #include "Queries.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
@@ -48,6 +49,16 @@ std::string ExportMemoryMap(const MemoryMap& m, const std::filesystem::path& pat
     options.color = color;
     py::gil_scoped_release release;
     return pipeline::ExportMap(*m.map, path, options);
+}
+
+py::dict WallsInMemory(const MemoryMap& self, const py::kwargs& options) {
+    const walls::WallConfig config = WallConfigFrom(options);
+    walls::WallResult result;
+    {
+        py::gil_scoped_release release;
+        result = walls::FindWalls(*self.map, config);
+    }
+    return WallsReport(*self.map, result, config);
 }
 
 }  // namespace
@@ -103,6 +114,10 @@ Returns {"points", "dropped", "clipped"} counts.)doc")
         .def("export", &ExportMemoryMap, py::arg("path"), py::arg("format") = "",
              py::arg("color") = "auto",
              "Writes the map for viewers: vdb, bt, ot, ply or png (default: from the name).")
+        .def("walls", &WallsInMemory,
+             R"doc(Walls and their slant angles (docs/walls.md), as `strata walls --json`
+reports them (walls, stats, config, ...) plus "voxels": center, slant_deg and wall_id of every
+wall voxel. Keyword options are WallConfig's fields (window_m=1.0, level_to_ground=False, ...).)doc")
         .def_property_readonly("voxel_size",
                                [](const MemoryMap& self) { return self.map->voxel_size; });
 }
