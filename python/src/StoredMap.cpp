@@ -2,14 +2,17 @@
 // store from Python is in this file, so a change of the store's API touches one place.
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <memory>
 #include <optional>
 
+#include "Analyses.hpp"
 #include "Arrays.hpp"
 #include "Bindings.hpp"
 #include "MemoryMap.hpp"
 #include "Queries.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/pipeline/Alignment.hpp"
 #include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/MapAccess.hpp"
 #include "strata/store/MapStore.hpp"
@@ -89,6 +92,48 @@ py::list SessionList(const StoredMap& m) {
     py::list out;
     for (const store::SessionRecord& s : m.Get().Latest().sessions) out.append(SessionDict(s));
     return out;
+}
+
+/// T_map_source from None (identity), a (4, 4) / (3, 4) pose or (x, y, z, yaw_deg).
+Eigen::Isometry3d GuessFrom(const py::object& init) {
+    if (init.is_none()) return Eigen::Isometry3d::Identity();
+    const py::array a = py::array::ensure(init);
+    if (a && a.ndim() == 1 && a.shape(0) == 4) {
+        const auto values = py::array_t<double, py::array::forcecast>(a);
+        const auto v = values.unchecked<1>();
+        if (!std::isfinite(v(0) + v(1) + v(2) + v(3))) {
+            throw InvalidArgumentError("init must be finite");
+        }
+        return registration::PoseFromXyzYaw(v(0), v(1), v(2), v(3));
+    }
+    if (!a) throw InvalidArgumentError("init must be a 4x4 pose or (x, y, z, yaw_deg)");
+    return PoseFromArray(a, "init");
+}
+
+py::dict Register(const StoredMap& m, const py::array& points, const py::object& init,
+                  const std::string& as_of, double margin, double min_range, double max_range,
+                  double min_overlap, double max_rmse) {
+    pipeline::SourceCloud cloud;
+    cloud.points = PointsFromArray(points);
+    cloud.scans = 1;
+    cloud.single_scan = true;
+    pipeline::AlignOptions options;
+    options.margin_m = margin;
+    options.min_range_m = min_range;
+    options.max_range_m = max_range;
+    options.config.min_overlap = min_overlap;
+    options.config.max_rmse_m = max_rmse;
+    const Eigen::Isometry3d guess = GuessFrom(init);
+    const MapStore& store = m.Get();
+    pipeline::MapAlignment a;
+    {
+        py::gil_scoped_release release;
+        a = pipeline::AlignToMap(store, pipeline::SelectSnapshot(store, as_of), cloud, guess,
+                                 options);
+    }
+    py::dict report = ParseJson(pipeline::AlignmentJson(a).dump());
+    report["pose"] = MatrixToArray(a.result.T_map_source.matrix());
+    return report;
 }
 
 /// One session being written: scans go in through `integrate`; `commit` records them all in
@@ -174,6 +219,9 @@ void RegisterStoredMap(py::module_& m) {
              [](const StoredMap& self, const std::string& id_or_name) {
                  return self.Get().FindSession(id_or_name);
              })
+        .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
+             py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),
+             py::arg("max_rmse"))
         .def(
             "export",
             [](const StoredMap& self, const std::string& path, const std::string& format,

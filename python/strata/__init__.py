@@ -196,6 +196,20 @@ class Map:
         """VoxelMap.columns on the newest state."""
         return self.snapshot().columns(window)
 
+    def register(self, points, init=None, as_of=None, margin: float = 10.0,
+                 min_range: float = 3.0, max_range: float = 60.0, min_overlap: float = 0.5,
+                 max_rmse: float = 0.15) -> dict:
+        """Where one scan (points (N, 3) in its sensor frame) sits in the map, as
+        `strata register --json` reports it (docs/registration.md): T (16 numbers, row-major,
+        scan -> map), converged, rmse_m, overlap, refusal, xyz_m, yaw_deg, ... plus "pose" as a
+        (4, 4) array. init: the guess, a 4x4 pose or (x, y, z, yaw_deg); margin: metres of map
+        read around it; points outside [min_range, max_range] of the sensor are left out. A
+        registration refused on its merits (overlap below min_overlap, rmse above max_rmse)
+        comes back with converged False and the reason in "refusal"; RefusedError when the map
+        has no surface near the guess. The map is only read."""
+        return self._impl.register(points, init, "" if as_of is None else str(as_of), margin,
+                                   min_range, max_range, min_overlap, max_rmse)
+
     def export(self, path, format: str = "", as_of=None) -> str:
         """Writes the map (or its state as of a session) as vdb, bt, ot, ply or png
         (default: from the file name); returns the format written."""

@@ -25,12 +25,15 @@ def run_strata(*args, cwd=None) -> subprocess.CompletedProcess:
 
 
 def tree_digest(path) -> dict:
-    """Every file under `path` with its SHA-256, but the writer's lock and SQLite's shared-memory
-    index (-shm), which readers rewrite without changing the catalog."""
+    """Every file under `path` with its SHA-256, but what readers touch without changing the
+    map: the writer's lock, SQLite's shared-memory index (-shm) and an empty write-ahead log."""
     root = pathlib.Path(path)
+
+    def content(p):
+        return not (p.name == "writer.lock" or p.name.endswith("-shm") or
+                    (p.name.endswith("-wal") and p.stat().st_size == 0))
     return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(root.rglob("*"))
-            if p.is_file() and p.name != "writer.lock" and not p.name.endswith("-shm")}
+            for p in sorted(root.rglob("*")) if p.is_file() and content(p)}
 
 
 @pytest.fixture(scope="session")
