@@ -12,7 +12,10 @@
 #include "MemoryMap.hpp"
 #include "Queries.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/Labels.hpp"
+#include "strata/core/Region.hpp"
 #include "strata/pipeline/Alignment.hpp"
+#include "strata/pipeline/Diff.hpp"
 #include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/MapAccess.hpp"
 #include "strata/store/MapStore.hpp"
@@ -136,6 +139,57 @@ py::dict Register(const StoredMap& m, const py::array& points, const py::object&
     return report;
 }
 
+/// Centres of the active voxels of a change mask, (M, 3) in the map frame.
+py::array_t<double> Centers(const openvdb::BoolGrid::Ptr& mask, const core::VoxelMap& frame) {
+    std::vector<Eigen::Vector3d> centers;
+    if (mask) {
+        for (auto it = mask->cbeginValueOn(); it; ++it) {
+            centers.push_back(frame.VoxelCenter(it.getCoord()));
+        }
+    }
+    return PointsToArray(centers);
+}
+
+py::dict Diff(const StoredMap& m, const std::string& from, const std::string& to,
+              const py::object& region, const std::string& class_name, size_t min_voxels, int gap,
+              int tolerance, int margin, int grow, int support) {
+    change::ChangeQuery query;
+    if (!region.is_none()) {
+        std::string text = py::isinstance<py::str>(region) ? region.cast<std::string>() : "";
+        if (text.empty()) {
+            for (const py::handle v : region) {
+                text += (text.empty() ? "" : ",") + py::str(v).cast<std::string>();
+            }
+        }
+        query.region = core::Region::Parse(text);
+    }
+    if (!class_name.empty()) query.class_filter = core::ClassFromName(class_name);
+    if (min_voxels < 1) throw InvalidArgumentError("min_voxels must be at least 1");
+    if (gap < 0 || tolerance < 0 || margin < 0 || grow < 0 || support < 0) {
+        throw InvalidArgumentError("gap, tolerance, margin, grow and support must be >= 0");
+    }
+    query.min_voxels = min_voxels;
+    query.gap_voxels = gap;
+    query.surface_tolerance_voxels = tolerance;
+    query.observed_margin_voxels = margin;
+    query.grow_voxels = grow;
+    query.support_depth_voxels = support;
+    const MapStore& store = m.Get();
+    pipeline::DiffResult result;
+    {
+        py::gil_scoped_release release;
+        change::MapObserver observer(store, query.region);
+        const pipeline::DiffSide a = pipeline::ResolveSide(from, store, observer);
+        const pipeline::DiffSide b = pipeline::ResolveSide(to, store, observer);
+        result = pipeline::CompareSides(a, b, store, query);
+    }
+    py::dict report = ParseJson(result.report);
+    const core::VoxelMap frame = store.EmptyMap();
+    report["added"] = Centers(result.changes.added, frame);
+    report["removed"] = Centers(result.changes.removed, frame);
+    return report;
+}
+
 /// One session being written: scans go in through `integrate`; `commit` records them all in
 /// one transaction; `abort` (or an exception in a `with` block) leaves the map as it was.
 class Session {
@@ -219,6 +273,9 @@ void RegisterStoredMap(py::module_& m) {
              [](const StoredMap& self, const std::string& id_or_name) {
                  return self.Get().FindSession(id_or_name);
              })
+        .def("diff", &Diff, py::arg("from_side"), py::arg("to_side"), py::arg("region"),
+             py::arg("class_name"), py::arg("min_voxels"), py::arg("gap"), py::arg("tolerance"),
+             py::arg("margin"), py::arg("grow"), py::arg("support"))
         .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
              py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),
              py::arg("max_rmse"))

@@ -196,6 +196,21 @@ class Map:
         """VoxelMap.columns on the newest state."""
         return self.snapshot().columns(window)
 
+    def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
+             gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
+             support: int = 3) -> dict:
+        """What changed from side `a` to side `b`, as `strata diff --json` reports it
+        (docs/change.md): objects [{id, kind, voxels, volume_m3, bbox_min, bbox_max, centroid,
+        class, oriented_box}], added_voxels, removed_voxels, unknown_voxels, ... plus "added"
+        and "removed": the centres of the changed voxels as (M, 3) arrays.
+
+        A side is a session (id or name: what it saw), "map" (the newest map) or "map@SESSION"
+        (the map right after it). region: (x0, y0, x1, y1), a polygon (x0, y0, x1, y1, x2, y2,
+        ...) or that text; class_name: only objects of that class ("vehicle"); the thresholds
+        as `strata diff`'s options. The map is only read."""
+        return self._impl.diff(str(a), str(b), region, class_name, min_voxels, gap, tolerance,
+                               margin, grow, support)
+
     def register(self, points, init=None, as_of=None, margin: float = 10.0,
                  min_range: float = 3.0, max_range: float = 60.0, min_overlap: float = 0.5,
                  max_rmse: float = 0.15) -> dict:
