@@ -196,6 +196,12 @@ class Map:
         """VoxelMap.columns on the newest state."""
         return self.snapshot().columns(window)
 
+    def walls(self, as_of=None, **options) -> dict:
+        """VoxelMap.walls on the newest state (or as of a session): the walls and their slant
+        angles as `strata walls --json --no-save` reports them, plus the wall voxels as arrays.
+        Options are WallConfig's fields (docs/walls.md)."""
+        return (self.snapshot() if as_of is None else self.as_of(as_of)).walls(**options)
+
     def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
              gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
              support: int = 3) -> dict:

@@ -21,6 +21,8 @@ def test_the_examples_of_docs_python_md_run(monkeypatch):
         exec(compile(block, "docs/python.md", "exec"), namespace)
     assert (namespace["work"] / "kitti00.png").stat().st_size > 1000
     assert len(namespace["walls"]["walls"]) == 10  # the street's ten walls (ground truth)
+    kinds = {(o["kind"], o["class"]) for o in namespace["changes"]["objects"]}
+    assert {("added", "vehicle"), ("removed", "vehicle"), ("added", "other")} <= kinds
     if os.environ.get("STRATA_KEEP_DOC_PICTURES"):  # how docs/images/python_slant.png is made
         (SOURCE_DIR / "docs" / "images" / "python_slant.png").write_bytes(
             (namespace["work"] / "slant.png").read_bytes())
