@@ -18,8 +18,10 @@
 #include "strata/pipeline/Diff.hpp"
 #include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/MapAccess.hpp"
+#include "strata/pipeline/Vehicles.hpp"
 #include "strata/store/MapStore.hpp"
 #include "strata/store/SessionWriter.hpp"
+#include "strata/vehicles/VehicleReport.hpp"
 
 namespace strata::python {
 
@@ -190,6 +192,27 @@ py::dict Diff(const StoredMap& m, const std::string& from, const std::string& to
     return report;
 }
 
+py::dict Vehicles(const StoredMap& m, const std::string& as_of, const std::string& source,
+                  bool ray_check, bool refill) {
+    vehicles::VehicleConfig config;
+    config.source = vehicles::SourceFromName(source);
+    config.ray_check = ray_check;
+    config.refill = refill;
+    const MapStore& store = m.Get();
+    auto outcome = std::make_shared<pipeline::VehiclesOutcome>();
+    {
+        py::gil_scoped_release release;
+        *outcome = pipeline::ClearVehicles(store, pipeline::SelectSnapshot(store, as_of), config);
+    }
+    py::dict report = ParseJson(vehicles::VehiclesJson(outcome->result, outcome->cleaned.origin));
+    MemoryMap cleaned;
+    cleaned.map = std::shared_ptr<core::VoxelMap>(outcome, &outcome->cleaned);
+    cleaned.config = m.config;
+    cleaned.read_only = true;
+    report["map"] = py::cast(std::move(cleaned));
+    return report;
+}
+
 /// One session being written: scans go in through `integrate`; `commit` records them all in
 /// one transaction; `abort` (or an exception in a `with` block) leaves the map as it was.
 class Session {
@@ -276,6 +299,8 @@ void RegisterStoredMap(py::module_& m) {
         .def("diff", &Diff, py::arg("from_side"), py::arg("to_side"), py::arg("region"),
              py::arg("class_name"), py::arg("min_voxels"), py::arg("gap"), py::arg("tolerance"),
              py::arg("margin"), py::arg("grow"), py::arg("support"))
+        .def("vehicles", &Vehicles, py::arg("as_of"), py::arg("source"), py::arg("ray_check"),
+             py::arg("refill"))
         .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
              py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),
              py::arg("max_rmse"))

@@ -202,6 +202,16 @@ class Map:
         Options are WallConfig's fields (docs/walls.md)."""
         return (self.snapshot() if as_of is None else self.as_of(as_of)).walls(**options)
 
+    def vehicles(self, as_of=None, source: str = "auto", ray_check: bool = True,
+                 refill: bool = True) -> dict:
+        """Parked vehicles cleared and the ground under them refilled (docs/vehicles.md), as
+        `strata vehicles --json --no-save` reports them: vehicles [{id, center, size, yaw_deg,
+        source, cleared_voxels, refilled_cells, refused_cells}], ... plus "map": the cleaned map
+        as a read-only VoxelMap. source: "auto", "label" or "geometric". The map on disk is not
+        changed."""
+        return self._impl.vehicles("" if as_of is None else str(as_of), source, ray_check,
+                                   refill)
+
     def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
              gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
              support: int = 3) -> dict:

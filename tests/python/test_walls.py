@@ -36,3 +36,23 @@ def test_unknown_wall_options_are_refused_with_the_list():
         m.walls(windw_m=2.0)
     with pytest.raises(strata.InvalidArgumentError, match="wrong type"):
         m.walls(window_m="wide")
+
+
+def test_vehicles_equal_strata_vehicles_json_and_leave_the_map_unchanged(tmp_path,
+                                                                        street_sequence):
+    from conftest import tree_digest
+    path = tmp_path / "street"
+    run_strata("integrate", path, "--kitti", street_sequence)
+    theirs = json.loads(run_strata("vehicles", path, "--json", "--no-save").stdout)
+    before = tree_digest(path)
+    with strata.Map.open(path, read_only=True) as m:
+        ours = m.vehicles()
+        vehicle = strata.CLASSES.index("vehicle")
+        labels_before = m.voxels([-1e4] * 3, [1e4] * 3, occupied_only=True)["label"]
+    cleaned = ours.pop("map")
+    ours.pop("seconds", None), theirs.pop("seconds", None)
+    assert ours == theirs
+    assert len(ours["vehicles"]) >= 3
+    labels_after = cleaned.voxels([-1e4] * 3, [1e4] * 3, occupied_only=True)["label"]
+    assert (labels_after == vehicle).sum() < (labels_before == vehicle).sum() / 2
+    assert tree_digest(path) == before
