@@ -15,11 +15,7 @@ namespace {
 MemoryMap CreateMemoryMap(double voxel, double max_range, double min_range, bool points_only,
                           bool keep_point_means) {
     MemoryMap m;
-    m.config.max_range_m = max_range;
-    m.config.min_range_m = min_range;
-    m.config.points_only = points_only;
-    m.config.keep_point_means = keep_point_means;
-    m.config.Validate();
+    m.config = IntegrationRule(max_range, min_range, points_only, keep_point_means);
     if (!(voxel > 0.0)) throw InvalidArgumentError("voxel must be > 0 (metres)");
     m.map = std::make_shared<core::VoxelMap>(core::VoxelMap::Create(voxel));
     return m;
@@ -62,6 +58,17 @@ py::dict WallsInMemory(const MemoryMap& self, const py::kwargs& options) {
 }
 
 }  // namespace
+
+integration::IntegrationConfig IntegrationRule(double max_range, double min_range, bool points_only,
+                                               bool keep_point_means) {
+    integration::IntegrationConfig config;
+    config.max_range_m = max_range;
+    config.min_range_m = min_range;
+    config.points_only = points_only;
+    config.keep_point_means = keep_point_means;
+    config.Validate();
+    return config;
+}
 
 py::dict UpdateCounts(size_t points, size_t dropped, size_t clipped) {
     py::dict out;

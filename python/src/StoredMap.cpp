@@ -68,11 +68,7 @@ StoredMap CreateStoredMap(const std::string& path, double voxel, double tile_siz
                           const py::object& origin, double max_range, double min_range,
                           bool points_only, bool keep_point_means) {
     StoredMap m;
-    m.config.max_range_m = max_range;
-    m.config.min_range_m = min_range;
-    m.config.points_only = points_only;
-    m.config.keep_point_means = keep_point_means;
-    m.config.Validate();
+    m.config = IntegrationRule(max_range, min_range, points_only, keep_point_means);
     store::StoreSettings settings;
     settings.voxel_size_m = voxel;
     settings.tile_size_m = tile_size;
