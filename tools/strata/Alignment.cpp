@@ -2,9 +2,9 @@
 
 #include <cmath>
 #include <iomanip>
-#include <stdexcept>
 
 #include "Progress.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/registration/SessionCloud.hpp"
 
 namespace strata::tools {
@@ -32,13 +32,13 @@ void AddAlignOptions(CLI::App& cmd, AlignArgs& args, bool ranges) {
 Eigen::Isometry3d InitialGuess(const AlignArgs& args) {
     if (args.init.empty()) return Eigen::Isometry3d::Identity();
     for (double v : args.init) {
-        if (!std::isfinite(v)) throw std::invalid_argument("--init: values must be finite");
+        if (!std::isfinite(v)) throw InvalidArgumentError("--init: values must be finite");
     }
     return registration::PoseFromXyzYaw(args.init[0], args.init[1], args.init[2], args.init[3]);
 }
 
 SourceCloud ReadSourceCloud(const ScanSource& source, bool as_is, const AlignArgs& args) {
-    if (source.size() == 0) throw std::invalid_argument("no scans to align");
+    if (source.size() == 0) throw InvalidArgumentError("no scans to align");
     registration::SessionCloudConfig cloud_config;
     cloud_config.min_range_m = args.min_range_m;
     cloud_config.max_range_m = args.max_range_m;
