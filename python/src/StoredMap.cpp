@@ -72,6 +72,7 @@ StoredMap CreateStoredMap(const std::string& path, double voxel, double tile_siz
     store::StoreSettings settings;
     settings.voxel_size_m = voxel;
     settings.tile_size_m = tile_size;
+    settings.integration = m.config;  // recorded: every later session fuses alike
     if (!origin.is_none()) settings.origin = Vector3FromObject(origin, "origin");
     if (MapStore::IsMap(path)) {
         throw InvalidArgumentError(path + " holds a map already; open it with strata.Map.open");
