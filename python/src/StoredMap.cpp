@@ -87,6 +87,7 @@ StoredMap OpenStoredMap(const std::string& path, bool read_only) {
     py::gil_scoped_release release;
     m.store = std::make_shared<MapStore>(
         pipeline::OpenMap(path, read_only ? MapStore::Access::kRead : MapStore::Access::kWrite));
+    m.config = m.store->settings().integration;  // the rule the map was created with
     return m;
 }
 

@@ -49,7 +49,7 @@ def test_as_of_shows_the_map_right_after_a_session(tmp_path, demo_scans):
         one, two = m.as_of("one"), m.as_of(2)
         assert 0 < one.info()["observed_voxels"] < two.info()["observed_voxels"]
         assert two.info() == m.snapshot().info()
-        with pytest.raises(strata.Error, match="nosuch"):
+        with pytest.raises(strata.NotFoundError, match="nosuch"):
             m.as_of("nosuch")
         with pytest.raises(strata.InvalidArgumentError, match="snapshot"):
             one.integrate(demo_scans[0].points, demo_scans[0].pose)
