@@ -114,6 +114,18 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
     /usr/bin/python3 "$root/bench/bench_viewer_page.py" "$build/tools/strata/strata" "$maps"
     rm -rf "$maps"
   fi
+  if compgen -G "$build/python/strata/_strata*.so" >/dev/null; then
+    echo
+    echo "## Python (\`bench/bench_python.py\`)"
+    echo
+    echo "KITTI 00 frames 0-5 into a new map (voxel 0.2 m) from numpy arrays with \`strata.Map\`"
+    echo "vs \`strata integrate --kitti --frames 0:6\` on the same files: the program timed from"
+    echo "start to exit, the module from \`Map.create\` to the commit with the files read by numpy."
+    echo "Target (issue 20): the module within 5 % of the program. Usage: [python.md](python.md)."
+    echo
+    PYTHONPATH="$build/python" /usr/bin/python3 "$root/bench/bench_python.py" \
+      "$build/tools/strata/strata" "$root/../shared/data"
+  fi
   if [[ -x "$build/bench/bench_sim" ]]; then
     echo
     echo "## Simulator (\`bench/bench_sim\`)"

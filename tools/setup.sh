@@ -27,6 +27,8 @@ packages=(
   libcpp-httplib-dev libjs-three                     # strata view: its server, three.js
   chromium python3-pytest python3-websocket          # strata view's browser tests
   clang-format              # tools/format.sh (.ci/run checks the formatting)
+  pybind11-dev python3-dev python3-numpy  # the Python module (python/, docs/python.md)
+  python3-matplotlib                      # docs/python.md's plotting example (tested)
 )
 
 missing=()
@@ -99,10 +101,13 @@ if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   "${sudo_cmd[@]}" mv "$tbb_source.partial" "$tbb_source"
 fi
 
-# The `strata` program and what it needs, in build/ as tools/test.sh configures it (same
-# settings, ccache), so the test command afterwards compiles only the rest.
+# The `strata` program, the Python module (when configured: python/CMakeLists.txt) and what
+# they need, in build/ as tools/test.sh configures it (same settings, ccache), so the test
+# command afterwards compiles only the rest.
 if ((build)); then
   root=$(cd "$(dirname "$0")/.." && pwd)
   "$root/tools/configure.sh"
-  cmake --build "$root/build" --target strata
+  targets=(strata)
+  [[ -d $root/build/python/strata ]] && targets+=(_strata)
+  cmake --build "$root/build" --target "${targets[@]}"
 fi

@@ -1,4 +1,6 @@
 // strata diff: what changed between two sessions, two states of the map, or the map and new scans.
+#include "strata/pipeline/Diff.hpp"
+
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -46,20 +48,7 @@ constexpr const char* kSideHelp =
     "right after SESSION)";
 
 // One side of the query, resolved against the map, with the name the report gives it.
-struct Side {
-    change::Observation observation;
-    std::string name;
-};
-
-Side Resolve(const std::string& text, const store::MapStore& map, change::MapObserver& observer) {
-    if (text == "map") return {observer.Map(map.Latest()), "map (newest)"};
-    if (text.rfind("map@", 0) == 0) {
-        const int64_t id = map.FindSession(text.substr(4));
-        return {observer.Map(map.AsOf(id)), "map as of session " + std::to_string(id)};
-    }
-    const int64_t id = map.FindSession(text);
-    return {observer.Session(id), "session " + std::to_string(id)};
-}
+using Side = pipeline::DiffSide;
 
 // The scans of --to-kitti / --to-scans integrated in memory with the map's voxel size and origin.
 Side ObserveScans(const DiffArgs& args, const store::MapStore& map) {
@@ -156,13 +145,13 @@ void Run(const DiffArgs& args) {
         args.map, args.save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
     change::MapObserver observer(map, query.region,
                                  static_cast<size_t>(args.memory_budget_mb * 1e6));
-    const Side a = Resolve(args.from.empty() ? "map" : args.from, map, observer);
-    const Side b = scans ? ObserveScans(args, map) : Resolve(args.to, map, observer);
+    const Side a = pipeline::ResolveSide(args.from.empty() ? "map" : args.from, map, observer);
+    const Side b = scans ? ObserveScans(args, map) : pipeline::ResolveSide(args.to, map, observer);
 
-    const change::ChangeSet changes =
-        change::DetectChanges(a.observation, b.observation, map.settings().voxel_size_m, query);
+    const pipeline::DiffResult diff = pipeline::CompareSides(a, b, map, query);
+    const change::ChangeSet& changes = diff.changes;
+    const std::string& report = diff.report;
     const change::ReportContext context{a.name, b.name, map.settings().origin, &query};
-    const std::string report = change::ChangeReportJson(changes, context);
     if (!args.vdb.empty()) change::WriteChangeVdb(changes, context, args.vdb);
     if (!args.png.empty()) {
         openvdb::BoolGrid::Ptr seen = a.observation.masks.occupied->deepCopy();

@@ -1,14 +1,12 @@
 // strata export: a map to the files viewers open (VDB, OctoMap .bt/.ot, PLY, PNG).
+#include "strata/pipeline/Export.hpp"
+
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
-#include "strata/io/OctomapExport.hpp"
-#include "strata/io/PlyExport.hpp"
-#include "strata/io/PngExport.hpp"
-#include "strata/io/VdbExport.hpp"
 
 namespace strata::tools {
 
@@ -24,37 +22,13 @@ struct ExportArgs {
 };
 
 void Run(const ExportArgs& args) {
-    std::string format = args.format;
-    if (format.empty()) {
-        const std::string ext = std::filesystem::path(args.out).extension().string();
-        if (ext.size() < 2) {
-            throw std::invalid_argument("--out " + args.out + ": no extension; give --format");
-        }
-        format = ext.substr(1);
-    }
+    pipeline::ExportOptions options;
+    options.format = args.format;
+    options.pixels_per_voxel = args.pixels_per_voxel;
+    options.color = args.color;
+    (void)pipeline::ExportFormat(args.out, options);  // a bad name fails before the map is read
     const store::MapStore store = OpenMap(args.map);
-    const core::VoxelMap map = store.LoadMap(SelectSnapshot(store, args.as_of));
-    if (format == "vdb") {
-        io::WriteVdb(map, args.out);
-    } else if (format == "bt" || format == "ot") {
-        if (std::filesystem::path(args.out).extension() != "." + format) {
-            throw std::invalid_argument("--out " + args.out + ": OctoMap files must end in ." +
-                                        format);
-        }
-        io::WriteOctomap(map, args.out);
-    } else if (format == "ply") {
-        io::WritePly(map, args.out);
-    } else if (format == "png") {
-        io::TopDownOptions options;
-        options.pixels_per_voxel = args.pixels_per_voxel;
-        // Unlabelled maps carry no class colours: show heights instead.
-        options.color_by_height = args.color == "height" ||
-                                  (args.color == "auto" && map.label->activeVoxelCount() == 0);
-        io::WriteTopDownPng(map, args.out, options);
-    } else {
-        throw std::invalid_argument("unknown export format '" + format +
-                                    "' (use vdb, bt, ot, ply or png)");
-    }
+    pipeline::ExportMap(store.LoadMap(SelectSnapshot(store, args.as_of)), args.out, options);
     std::cout << "wrote " << args.out << " (" << std::filesystem::file_size(args.out)
               << " bytes)\n";
 }
@@ -63,7 +37,8 @@ void Run(const ExportArgs& args) {
 
 void RegisterExport(CLI::App& app) {
     auto args = std::make_shared<ExportArgs>();
-    CLI::App* cmd = app.add_subcommand("export", "Export a map for viewers (VDB, OctoMap, PLY, PNG)");
+    CLI::App* cmd =
+        app.add_subcommand("export", "Export a map for viewers (VDB, OctoMap, PLY, PNG)");
     cmd->footer(
         "Examples:\n"
         "  strata export city.strata --out city.vdb          # vdb_print, vdb_view, Blender\n"
@@ -75,8 +50,9 @@ void RegisterExport(CLI::App& app) {
     cmd->add_option("--out", args->out, "Output file")->required();
     cmd->add_option("--pixels-per-voxel", args->pixels_per_voxel, "PNG scale")
         ->capture_default_str();
-    cmd->add_option("--color", args->color, "PNG colours: class, height, or auto (height when "
-                                            "the map has no labels)")
+    cmd->add_option("--color", args->color,
+                    "PNG colours: class, height, or auto (height when "
+                    "the map has no labels)")
         ->check(CLI::IsMember({"auto", "class", "height"}))
         ->capture_default_str();
     cmd->add_option("--as-of", args->as_of, "Export the map as it was right after this session");

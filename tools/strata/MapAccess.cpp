@@ -1,9 +1,7 @@
 #include "MapAccess.hpp"
 
 #include <cstdlib>
-#include <stdexcept>
 
-#include "strata/core/Error.hpp"
 #include "strata/io/AtomicFile.hpp"
 #include "strata/io/VdbExport.hpp"
 
@@ -17,18 +15,6 @@ fs::path FindDataDir() {
         if (fs::is_directory(candidate)) return fs::weakly_canonical(candidate);
     }
     return {};
-}
-
-store::MapStore OpenMap(const fs::path& dir, store::MapStore::Access access) {
-    if (!fs::exists(dir)) {
-        throw NotFoundError(dir.string() + ": no map here (create one with `strata integrate " +
-                                 dir.string() + " --kitti SEQ`)");
-    }
-    return store::MapStore::Open(dir, access);
-}
-
-store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of) {
-    return as_of.empty() ? map.Latest() : map.AsOf(map.FindSession(as_of));
 }
 
 void WriteTextFile(const std::string& path, const std::string& text) {

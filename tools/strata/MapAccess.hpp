@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <string>
 
+#include "strata/pipeline/MapAccess.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::tools {
@@ -12,14 +13,9 @@ namespace strata::tools {
 /// from the executable's source checkout. Empty when none exists.
 [[nodiscard]] std::filesystem::path FindDataDir();
 
-/// Opens MAP for reading (or as its writer), failing with a message that says how to create one.
-[[nodiscard]] store::MapStore OpenMap(
-    const std::filesystem::path& dir,
-    store::MapStore::Access access = store::MapStore::Access::kRead);
-
-/// The commit a read command shows: the newest, or the one right after session `as_of` (an id
-/// or a name) when given.
-[[nodiscard]] store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of);
+// Opening a map and choosing its snapshot are use cases the Python module shares (pipeline).
+using pipeline::OpenMap;
+using pipeline::SelectSnapshot;
 
 /// Writes a text file all or nothing (io::WriteFileAtomically: temporary file, fsync, rename).
 void WriteTextFile(const std::string& path, const std::string& text);

@@ -1,4 +1,6 @@
 // strata vehicles: parked vehicles cleared from a map and the ground under them refilled.
+#include "strata/pipeline/Vehicles.hpp"
+
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -26,18 +28,6 @@ struct VehiclesArgs {
     bool no_refill = false;
     double picture_height_m = 2.5;
 };
-
-// Sensor positions of every scan of the snapshot's sessions, in the map frame.
-std::vector<Eigen::Vector3d> Origins(const store::MapStore& map, const store::Snapshot& snapshot,
-                                     const Eigen::Vector3d& map_origin) {
-    std::vector<Eigen::Vector3d> origins;
-    for (const store::SessionRecord& s : snapshot.sessions) {
-        for (const store::ScanRecord& scan : map.Scans(s.id)) {
-            origins.push_back(scan.pose.translation() - map_origin);
-        }
-    }
-    return origins;
-}
 
 // One row of the vehicles view (docs/store.md, "Products"; meaning of each key: docs/vehicles.md).
 std::string VehicleRow(const vehicles::Vehicle& v) {
@@ -98,7 +88,7 @@ void Run(VehiclesArgs& args) {
         OpenMap(args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
     const store::Snapshot snapshot = SelectSnapshot(map, args.as_of);
     core::VoxelMap voxels = map.LoadMap(snapshot);
-    const std::vector<Eigen::Vector3d> origins = Origins(map, snapshot, voxels.origin);
+    const std::vector<Eigen::Vector3d> origins = pipeline::SensorOrigins(map, snapshot);
     const core::VoxelMap before = args.png.empty() ? core::VoxelMap{} : voxels.DeepCopy();
     const vehicles::VehicleResult result = vehicles::ClearVehicles(voxels, origins, args.config);
 

@@ -1,0 +1,247 @@
+"""strata: a GPU-free voxel database for LiDAR maps, numpy in and out.
+
+Scans go in as numpy arrays (points (N, 3), a 4x4 pose, optional labels), maps come back as
+numpy arrays (occupancy at points, the voxels in a box, column statistics) and as the files
+viewers open. Every call releases the GIL while C++ works. Errors are strata.Error and its
+subclasses, one per kind the library reports. See docs/python.md.
+"""
+from dataclasses import dataclass
+from typing import Iterator, Optional
+
+import numpy as np
+
+from . import _strata
+from ._strata import (CLASSES, Error, FormatError, InvalidArgumentError, IoError,
+                      MapLockedError, NotFoundError, RefusedError, VoxelMap)
+
+__all__ = ["CLASSES", "Error", "FormatError", "InvalidArgumentError", "IoError", "Map",
+           "MapLockedError", "NotFoundError", "RefusedError", "Scan", "Session", "VoxelMap",
+           "read_kitti", "read_points", "simulate"]
+
+
+@dataclass
+class Scan:
+    """One LiDAR sweep as arrays.
+
+    points: (N, 3) sensor frame, metres; pose: (4, 4) sensor-to-map transform;
+    labels: (N,) SemanticKITTI ids (class | instance << 16) or None;
+    classes: (N,) strata class ids (index into strata.CLASSES) or None;
+    intensity: (N,) or None; time: seconds.
+    """
+    points: np.ndarray
+    pose: np.ndarray
+    labels: Optional[np.ndarray] = None
+    classes: Optional[np.ndarray] = None
+    intensity: Optional[np.ndarray] = None
+    time: float = 0.0
+
+
+def read_points(path, bin_fields: int = 0, origin=None) -> Scan:
+    """Reads a point cloud: .pcd, .ply, .las, raw float32 .bin (KITTI, nuScenes .pcd.bin),
+    text (.txt .xyz .csv .dat) and .bz2-compressed text.
+
+    Points are float64 in the file's frame minus `origin`; `classes` holds the file's labels
+    mapped to strata's classes (None when it has none). bin_fields: float32 values per point of
+    a .bin file (4 KITTI, 5 nuScenes, 0 from the name or size). The pose is the identity.
+    """
+    d = _strata._read_points(str(path), bin_fields, origin)
+    return Scan(points=d["points"], pose=d["pose"], classes=d["classes"],
+                intensity=d["intensity"], time=d["time"])
+
+
+def read_kitti(sequence) -> dict:
+    """Indexes a KITTI / SemanticKITTI sequence folder without loading scans.
+
+    Returns {"scans": [velodyne/*.bin paths], "labels": [labels/*.label paths or empty],
+    "poses": (N, 4, 4) sensor poses (calib.txt's Tr applied, as `strata integrate --kitti`),
+    "times": (N,)}. Read a scan with np.fromfile(path, np.float32).reshape(-1, 4)[:, :3].
+    """
+    return _strata._read_kitti(str(sequence))
+
+
+def simulate(scene="demo", session: int = 0, sensor: Optional[str] = None,
+             seed: Optional[int] = None, max_scans: int = 0) -> Iterator[Scan]:
+    """Yields the scans of one session of a simulated scene (docs/simulator.md), one at a time.
+
+    scene: a scene file (datasets/scenes/*.json) or "demo" (a small built-in street).
+    Each Scan carries float32 points in the sensor frame, SemanticKITTI `labels`, strata
+    `classes` and the pose in the session's frame: what `strata simulate` writes for it.
+    """
+    sim = _strata._Simulation(str(scene), session, sensor or "", seed, max_scans)
+    for k in range(len(sim)):
+        d = sim.scan(k)
+        yield Scan(points=d["points"], pose=d["pose"], labels=d["labels"],
+                   classes=d["classes"], time=d["time"])
+
+
+class Session:
+    """One session being added to a Map: integrate scans, then commit them all at once.
+
+    Used as `with map.session("name") as s: s.integrate(points, pose)`, it commits when the
+    block ends and, when the block raises, removes what it wrote: the map is as before.
+    """
+
+    def __init__(self, map: "Map", name: str = "", memory_budget_mb: float = 0.0):
+        self._map = map
+        self._impl = _strata._Session(map._impl, name, memory_budget_mb)
+
+    def integrate(self, points, pose, labels=None, classes=None) -> dict:
+        """Integrates one scan (see VoxelMap.integrate for the arrays); nothing reaches the
+        map on disk before commit(). Returns {"points", "dropped", "clipped"}."""
+        return self._impl.integrate(points, pose, labels, classes)
+
+    def commit(self) -> dict:
+        """Writes the session in one transaction; returns its record (as Map.sessions())."""
+        record = self._impl.commit()
+        self._map._newest = None
+        return record
+
+    def abort(self) -> None:
+        """Drops everything this session wrote; the map on disk stays as it was."""
+        self._impl.abort()
+
+    @property
+    def record(self) -> Optional[dict]:
+        """The committed session's record, None before commit."""
+        return self._impl.record
+
+    def __enter__(self) -> "Session":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.abort()
+        return False
+
+
+class Map:
+    """A map on disk: a transactional store of sessions (docs/store.md).
+
+    Create one with Map.create, open one with Map.open; add scans in sessions; query the newest
+    state (occupancy, voxels, columns) or any session's (as_of); export for viewers. A Map
+    opened for writing holds the map's writer lock until close() (or the end of a `with`).
+    """
+
+    def __init__(self, impl):
+        self._impl = impl
+        self._newest = None
+
+    @staticmethod
+    def create(path, voxel: float = 0.2, tile_size: float = 64.0, origin=None,
+               max_range: float = 50.0, min_range: float = 0.0, points_only: bool = False,
+               keep_point_means: bool = True) -> "Map":
+        """Creates an empty map in `path` (absent or empty) and opens it for writing.
+
+        voxel and tile_size in metres; origin: the world position of map coordinate (0, 0, 0)
+        for georeferenced data; the integration rule as `strata integrate`'s options."""
+        return Map(_strata._Map.create(str(path), voxel, tile_size, origin, max_range,
+                                       min_range, points_only, keep_point_means))
+
+    @staticmethod
+    def open(path, read_only: bool = False) -> "Map":
+        """Opens the map in `path`; for writing (the default) it takes the writer lock
+        (MapLockedError when another process holds it)."""
+        return Map(_strata._Map.open(str(path), read_only))
+
+    def close(self) -> None:
+        """Releases the map (and its writer lock)."""
+        self._impl.close()
+        self._newest = None
+
+    def __enter__(self) -> "Map":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        self.close()
+        return False
+
+    @property
+    def path(self) -> str:
+        return self._impl.path
+
+    @property
+    def voxel_size(self) -> float:
+        return self._impl.voxel_size
+
+    def session(self, name: str = "", memory_budget_mb: float = 0.0) -> Session:
+        """A new session named `name` (default session_<id>); use it in a `with` block.
+        memory_budget_mb > 0 keeps at most that many MB of tiles in memory."""
+        return Session(self, name, memory_budget_mb)
+
+    def sessions(self) -> list:
+        """The map's sessions, oldest first, as dicts (id, name, scans, points, ...)."""
+        return self._impl.sessions()
+
+    def as_of(self, session) -> VoxelMap:
+        """The map right after `session` (an id or a name) was committed, read-only."""
+        return self._impl.load(str(session))
+
+    def snapshot(self) -> VoxelMap:
+        """The newest state as a read-only VoxelMap (read once, until the next commit)."""
+        if self._newest is None:
+            self._newest = self._impl.load("")
+        return self._newest
+
+    def occupancy(self, points) -> dict:
+        """VoxelMap.occupancy on the newest state."""
+        return self.snapshot().occupancy(points)
+
+    def voxels(self, lo, hi, occupied_only: bool = False) -> dict:
+        """VoxelMap.voxels on the newest state."""
+        return self.snapshot().voxels(lo, hi, occupied_only)
+
+    def columns(self, window: int = 0) -> dict:
+        """VoxelMap.columns on the newest state."""
+        return self.snapshot().columns(window)
+
+    def walls(self, as_of=None, **options) -> dict:
+        """VoxelMap.walls on the newest state (or as of a session): the walls and their slant
+        angles as `strata walls --json --no-save` reports them, plus the wall voxels as arrays.
+        Options are WallConfig's fields (docs/walls.md)."""
+        return (self.snapshot() if as_of is None else self.as_of(as_of)).walls(**options)
+
+    def vehicles(self, as_of=None, source: str = "auto", ray_check: bool = True,
+                 refill: bool = True) -> dict:
+        """Parked vehicles cleared and the ground under them refilled (docs/vehicles.md), as
+        `strata vehicles --json --no-save` reports them: vehicles [{id, center, size, yaw_deg,
+        source, cleared_voxels, refilled_cells, refused_cells}], ... plus "map": the cleaned map
+        as a read-only VoxelMap. source: "auto", "label" or "geometric". The map on disk is not
+        changed."""
+        return self._impl.vehicles("" if as_of is None else str(as_of), source, ray_check,
+                                   refill)
+
+    def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
+             gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
+             support: int = 3) -> dict:
+        """What changed from side `a` to side `b`, as `strata diff --json` reports it
+        (docs/change.md): objects [{id, kind, voxels, volume_m3, bbox_min, bbox_max, centroid,
+        class, oriented_box}], added_voxels, removed_voxels, unknown_voxels, ... plus "added"
+        and "removed": the centres of the changed voxels as (M, 3) arrays.
+
+        A side is a session (id or name: what it saw), "map" (the newest map) or "map@SESSION"
+        (the map right after it). region: (x0, y0, x1, y1), a polygon (x0, y0, x1, y1, x2, y2,
+        ...) or that text; class_name: only objects of that class ("vehicle"); the thresholds
+        as `strata diff`'s options. The map is only read."""
+        return self._impl.diff(str(a), str(b), region, class_name, min_voxels, gap, tolerance,
+                               margin, grow, support)
+
+    def register(self, points, init=None, as_of=None, margin: float = 10.0,
+                 min_range: float = 3.0, max_range: float = 60.0, min_overlap: float = 0.5,
+                 max_rmse: float = 0.15) -> dict:
+        """Where one scan (points (N, 3) in its sensor frame) sits in the map, as
+        `strata register --json` reports it (docs/registration.md): T (16 numbers, row-major,
+        scan -> map), converged, rmse_m, overlap, refusal, xyz_m, yaw_deg, ... plus "pose" as a
+        (4, 4) array. init: the guess, a 4x4 pose or (x, y, z, yaw_deg); margin: metres of map
+        read around it; points outside [min_range, max_range] of the sensor are left out. A
+        registration refused on its merits (overlap below min_overlap, rmse above max_rmse)
+        comes back with converged False and the reason in "refusal"; RefusedError when the map
+        has no surface near the guess. The map is only read."""
+        return self._impl.register(points, init, "" if as_of is None else str(as_of), margin,
+                                   min_range, max_range, min_overlap, max_rmse)
+
+    def export(self, path, format: str = "", as_of=None) -> str:
+        """Writes the map (or its state as of a session) as vdb, bt, ot, ply or png
+        (default: from the file name); returns the format written."""
+        return self._impl.export(str(path), format, "" if as_of is None else str(as_of))

@@ -1,0 +1,94 @@
+"""strata.Map: sessions commit at the end of a `with` block and leave nothing behind when it
+raises; snapshots, locks and read-only maps behave as the store promises (docs/store.md)."""
+import numpy as np
+import pytest
+
+import strata
+from conftest import tree_digest
+
+
+def integrate(session, scans):
+    for scan in scans:
+        session.integrate(scan.points, scan.pose, labels=scan.labels)
+
+
+def test_a_session_commits_at_the_end_of_its_block(tmp_path, demo_scans):
+    with strata.Map.create(tmp_path / "map", voxel=0.2) as m:
+        assert m.sessions() == []
+        with m.session("drive") as s:
+            integrate(s, demo_scans)
+            assert m.sessions() == []  # nothing visible before the commit
+        assert s.record["name"] == "drive" and s.record["scans"] == 3
+        assert s.record["points"] == sum(len(x.points) for x in demo_scans)
+        assert [x["name"] for x in m.sessions()] == ["drive"]
+        q = m.occupancy(demo_scans[0].points[:1000].astype(np.float64)
+                        @ demo_scans[0].pose[:3, :3].T + demo_scans[0].pose[:3, 3])
+        assert (q["state"] == 1).mean() > 0.9  # the endpoints of a scan are occupied
+
+
+def test_a_session_that_raises_leaves_nothing_behind(tmp_path, demo_scans):
+    path = tmp_path / "map"
+    with strata.Map.create(path, voxel=0.2) as m:
+        with m.session("first") as s:
+            integrate(s, demo_scans[:1])
+        before = tree_digest(path)
+        with pytest.raises(KeyError):
+            with m.session("second") as s:
+                integrate(s, demo_scans[1:])
+                raise KeyError("the user's own error")
+        assert tree_digest(path) == before
+        assert [x["name"] for x in m.sessions()] == ["first"]
+
+
+def test_as_of_shows_the_map_right_after_a_session(tmp_path, demo_scans):
+    with strata.Map.create(tmp_path / "map", voxel=0.2) as m:
+        with m.session("one") as s:
+            integrate(s, demo_scans[:1])
+        with m.session("two") as s:
+            integrate(s, demo_scans[1:])
+        one, two = m.as_of("one"), m.as_of(2)
+        assert 0 < one.info()["observed_voxels"] < two.info()["observed_voxels"]
+        assert two.info() == m.snapshot().info()
+        with pytest.raises(strata.NotFoundError, match="nosuch"):
+            m.as_of("nosuch")
+        with pytest.raises(strata.InvalidArgumentError, match="snapshot"):
+            one.integrate(demo_scans[0].points, demo_scans[0].pose)
+
+
+def test_export_of_a_stored_map_equals_the_program_export(tmp_path, demo_scans):
+    from conftest import run_strata
+    with strata.Map.create(tmp_path / "map", voxel=0.2) as m:
+        with m.session() as s:
+            integrate(s, demo_scans)
+        assert m.export(tmp_path / "ours.ply") == "ply"
+    run_strata("export", tmp_path / "map", "--out", tmp_path / "theirs.ply")
+    assert (tmp_path / "ours.ply").read_bytes() == (tmp_path / "theirs.ply").read_bytes()
+
+
+def test_open_errors_have_their_kinds(tmp_path, demo_scans):
+    with pytest.raises(strata.NotFoundError, match="no map here"):
+        strata.Map.open(tmp_path / "missing")
+    path = tmp_path / "map"
+    writer = strata.Map.create(path)
+    with pytest.raises(strata.InvalidArgumentError, match="holds a map already"):
+        strata.Map.create(path)
+    with pytest.raises(strata.MapLockedError):
+        strata.Map.open(path)
+    reader = strata.Map.open(path, read_only=True)  # readers do not need the lock
+    with pytest.raises(strata.InvalidArgumentError, match="read-only"):
+        reader.session("x")
+    writer.close()
+    with pytest.raises(strata.InvalidArgumentError, match="closed"):
+        writer.sessions()
+    with strata.Map.open(path) as again:  # the lock went with close()
+        with again.session("x") as s:
+            integrate(s, demo_scans[:1])
+    assert [x["name"] for x in reader.sessions()] == ["x"]
+
+
+def test_a_committed_session_cannot_be_used_again(tmp_path, demo_scans):
+    with strata.Map.create(tmp_path / "map") as m:
+        with m.session() as s:
+            integrate(s, demo_scans[:1])
+        with pytest.raises(strata.InvalidArgumentError, match="committed or aborted"):
+            integrate(s, demo_scans[1:2])
