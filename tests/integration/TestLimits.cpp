@@ -67,7 +67,7 @@ TEST(Limits, EmptyAndAllNanScansChangeNothing) {
     EXPECT_EQ(dropped.points, 1000u);
     EXPECT_EQ(dropped.dropped, 1000u);
     EXPECT_EQ(map.occupancy->activeVoxelCount(), 0u);
-    EXPECT_EQ(map.hits->activeVoxelCount(), 0u);
+    EXPECT_EQ(map.endpoints->activeVoxelCount(), 0u);
     // A sensor pose that is not finite is refused, naming the problem.
     core::Scan bad = SphereScan(10, 5.0, 1);
     bad.T_world_sensor.translation().x() = std::numeric_limits<double>::infinity();
