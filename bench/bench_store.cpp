@@ -185,7 +185,7 @@ void TouchValues(const strata::store::Tile& tile) {
     touch(*tile.fused.occupancy);
     touch(*tile.fused.label);
     touch(*tile.fused.label_weight);
-    touch(*tile.fused.hits);
+    touch(*tile.fused.endpoints);
 }
 
 struct ReadTimes {

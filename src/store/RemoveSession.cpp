@@ -61,8 +61,7 @@ int64_t MapStore::RemoveSession(int64_t session_id) {
         auto occupancy = tile.fused.occupancy->getAccessor();
         auto label = tile.fused.label->getAccessor();
         auto weight = tile.fused.label_weight->getAccessor();
-        auto hits = tile.fused.hits->getAccessor();
-        auto mean = tile.fused.point_mean->getAccessor();
+        auto endpoints = tile.fused.endpoints->getAccessor();
         for (auto it = seen.cbeginValueOn(); it; ++it) {
             const openvdb::Coord ijk = it.getCoord();
             float value = 0.0f;
@@ -84,8 +83,7 @@ int64_t MapStore::RemoveSession(int64_t session_id) {
             if (!observed || value <= 0.0f) {
                 label.setValueOff(ijk, 0);
                 weight.setValueOff(ijk, 0.0f);
-                hits.setValueOff(ijk, 0);
-                mean.setValueOff(ijk, openvdb::Vec3s(0.0f));
+                endpoints.setValueOff(ijk, 0);
             }
         }
         TileVersion v;

@@ -244,8 +244,7 @@ struct SessionWriter::State {
         openvdb::tools::pruneInactive(work.occupancy->tree());
         openvdb::tools::pruneInactive(work.label->tree());
         openvdb::tools::pruneInactive(work.label_weight->tree());
-        openvdb::tools::pruneInactive(work.point_mean->tree());
-        openvdb::tools::pruneInactive(work.hits->tree());
+        openvdb::tools::pruneInactive(work.endpoints->tree());
         openvdb::tools::pruneInactive(session->tree());
     }
 

@@ -171,9 +171,7 @@ Tile DecodeTile(const std::string& bytes, const TileKey& key, const fs::path& pa
         throw std::runtime_error(path.string() + ": " + e.what());
     }
     for (const auto& grid : fused) {
-        if (grid != tile.fused.occupancy && grid != tile.fused.label &&
-            grid != tile.fused.label_weight && grid != tile.fused.hits &&
-            grid != tile.fused.point_mean) {
+        if (!core::VoxelMap::IsMapGrid(grid->getName())) {
             tile.products.push_back(grid);
         }
     }

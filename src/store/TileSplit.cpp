@@ -7,8 +7,7 @@ std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapS
     auto occupancy = StealTiles(*work.occupancy, settings, keys);
     auto label = StealTiles(*work.label, settings, keys);
     auto label_weight = StealTiles(*work.label_weight, settings, keys);
-    auto hits = StealTiles(*work.hits, settings, keys);
-    auto point_mean = StealTiles(*work.point_mean, settings, keys);
+    auto endpoints = StealTiles(*work.endpoints, settings, keys);
     std::map<TileKey, core::VoxelMap> out;
     const auto take = [](auto& tiles, const TileKey& key, auto& grid) {
         const auto it = tiles.find(key);
@@ -20,21 +19,18 @@ std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapS
     add_keys(occupancy);
     add_keys(label);
     add_keys(label_weight);
-    add_keys(hits);
-    add_keys(point_mean);
+    add_keys(endpoints);
     for (auto& [key, tile] : out) {
         tile.voxel_size = work.voxel_size;
         tile.origin = work.origin;
         tile.occupancy = work.occupancy->copyWithNewTree();
         tile.label = work.label->copyWithNewTree();
         tile.label_weight = work.label_weight->copyWithNewTree();
-        tile.hits = work.hits->copyWithNewTree();
-        tile.point_mean = work.point_mean->copyWithNewTree();
+        tile.endpoints = work.endpoints->copyWithNewTree();
         take(occupancy, key, tile.occupancy);
         take(label, key, tile.label);
         take(label_weight, key, tile.label_weight);
-        take(hits, key, tile.hits);
-        take(point_mean, key, tile.point_mean);
+        take(endpoints, key, tile.endpoints);
     }
     return out;
 }
@@ -43,8 +39,7 @@ void MergeMap(core::VoxelMap& into, core::VoxelMap& tile) {
     MergeLeaves(*into.occupancy, *tile.occupancy);
     MergeLeaves(*into.label, *tile.label);
     MergeLeaves(*into.label_weight, *tile.label_weight);
-    MergeLeaves(*into.hits, *tile.hits);
-    MergeLeaves(*into.point_mean, *tile.point_mean);
+    MergeLeaves(*into.endpoints, *tile.endpoints);
 }
 
 }  // namespace strata::store::detail
