@@ -1,7 +1,7 @@
 add_executable(bench_integration bench_integration.cpp)
 target_link_libraries(bench_integration PRIVATE Strata::integration Strata::io strata_test_support
                                                 TBB::tbb)
-target_compile_definitions(bench_integration PRIVATE STRATA_DATA_DIR="${STRATA_DATA_DIR}")
+strata_use_build_paths(bench_integration)
 strata_set_warnings(bench_integration)
 # The short run in CI: fails when a voxel differs from OctoMap's or a ratio misses its floor.
 add_test(NAME BenchIntegrationCi COMMAND bench_integration --ci)

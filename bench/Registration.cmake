@@ -3,6 +3,5 @@
 add_executable(bench_registration ${CMAKE_CURRENT_LIST_DIR}/bench_registration.cpp)
 target_link_libraries(bench_registration PRIVATE Strata::registration Strata::integration
                                                  Strata::io Strata::sim TBB::tbb)
-target_compile_definitions(bench_registration PRIVATE STRATA_DATA_DIR="${STRATA_DATA_DIR}"
-                                                      STRATA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+strata_use_build_paths(bench_registration)
 strata_set_warnings(bench_registration)

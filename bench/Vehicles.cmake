@@ -2,6 +2,5 @@
 add_executable(bench_vehicles ${CMAKE_CURRENT_LIST_DIR}/bench_vehicles.cpp)
 target_link_libraries(bench_vehicles PRIVATE strata_parking_eval Strata::vehicles
                       Strata::integration Strata::io TBB::tbb)
-target_compile_definitions(bench_vehicles PRIVATE STRATA_DATA_DIR="${STRATA_DATA_DIR}"
-                           STRATA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+strata_use_build_paths(bench_vehicles)
 strata_set_warnings(bench_vehicles)

@@ -73,6 +73,25 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
     echo
     "$build/bench/bench_vehicles" "$root/../shared/data"
   fi
+  if [[ -x "$build/bench/bench_viewer" ]]; then
+    echo
+    echo "## Viewer (\`bench/bench_viewer\`, \`bench/bench_viewer_page.py\`)"
+    echo
+    echo "\`strata view\` (issue 21). First, one tile answer of BALM at 0.1 m in 64 m tiles at each"
+    echo "level of detail, step by step and over HTTP, cold (a server without caches: the tile"
+    echo "file is read, verified and decoded whole) and as \`strata view\` serves it (tiles read"
+    echo "at start and kept; the cache of finished answers off). Target: median under 50 ms."
+    echo "Then the first picture in headless Chromium (SwiftShader) of BALM at 0.2 m and of ten"
+    echo "copies of it side by side, from navigation start; target under 2 s, the same for the"
+    echo "10x map, which sends only the tiles in view. Design: [viewer.md](viewer.md)."
+    echo
+    maps=$(mktemp -d)
+    trap 'rm -rf "$maps"' EXIT
+    "$build/bench/bench_viewer" "$root/../shared/data" --keep "$maps"
+    echo
+    /usr/bin/python3 "$root/bench/bench_viewer_page.py" "$build/tools/strata/strata" "$maps"
+    rm -rf "$maps"
+  fi
   if [[ -x "$build/bench/bench_sim" ]]; then
     echo
     echo "## Simulator (\`bench/bench_sim\`)"

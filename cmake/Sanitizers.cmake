@@ -12,8 +12,10 @@ if(STRATA_BUILD_FUZZ OR STRATA_SANITIZE)
                         "-DCMAKE_CXX_COMPILER=clang++ (tools/fuzz.sh and tools/sanitize.sh do)")
   endif()
   # After the build type's -O2 -g, so these win: -O1 and line tables only, to compile the
-  # OpenVDB-heavy files faster; line tables are all a sanitizer report needs.
-  add_compile_options(-O1 -gline-tables-only)
+  # OpenVDB-heavy files faster; line tables are all a sanitizer report needs. With debug
+  # information ccache hashes the build directory; mapped to a path relative to the source
+  # root, it is the same in every clone (cmake/Ccache.cmake).
+  add_compile_options(-O1 -gline-tables-only -fdebug-prefix-map=${PROJECT_SOURCE_DIR}=.)
 endif()
 
 if(STRATA_BUILD_FUZZ AND STRATA_SANITIZE)
@@ -22,11 +24,19 @@ if(STRATA_BUILD_FUZZ AND STRATA_SANITIZE)
 elseif(STRATA_BUILD_FUZZ)
   # Coverage for libFuzzer on everything; only the fuzz targets link libFuzzer's main
   # (-fsanitize=fuzzer, tests/fuzz/CMakeLists.txt), so the same objects make the test binaries
-  # of the ASan + UBSan run too. The ignorelist gives the reason for each entry.
+  # of the ASan + UBSan run too. The ignorelist gives the reason for each entry. Its path is
+  # relative to the build directory, where Ninja runs the compiler: ccache hashes the flag as
+  # written, and an absolute path would differ between clones. ccache does not read the file,
+  # so its checksum goes into a definition: a changed ignorelist recompiles everything.
+  set(ignorelist ${PROJECT_SOURCE_DIR}/tests/fuzz/SanitizerIgnorelist.txt)
+  file(RELATIVE_PATH ignorelist_relative ${PROJECT_BINARY_DIR} ${ignorelist})
+  file(MD5 ${ignorelist} ignorelist_md5)
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${ignorelist})
   add_compile_options(-fsanitize=fuzzer-no-link,address,undefined
                       -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-                      -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/tests/fuzz/SanitizerIgnorelist.txt
+                      -fsanitize-ignorelist=${ignorelist_relative}
                       -Wno-unknown-warning-option)  # cmake/Warnings.cmake has gcc's -Wshadow=local
+  add_compile_definitions(STRATA_SANITIZER_IGNORELIST_MD5=${ignorelist_md5})
   add_link_options(-fsanitize=address,undefined)
 elseif(STRATA_SANITIZE STREQUAL "thread")
   # TBB's scheduler must be instrumented too, or every hand-over of work between its threads is

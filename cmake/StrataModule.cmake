@@ -12,6 +12,7 @@ function(strata_add_module)
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   strata_set_warnings(${target})
+  strata_unity(${target})
 endfunction()
 
 # strata_add_gtest(<name> <sources...> LINKS <targets...>): one test binary, discovered by CTest.
@@ -19,9 +20,9 @@ function(strata_add_gtest name)
   cmake_parse_arguments(ARG "" "" "LINKS" ${ARGN})
   add_executable(${name} ${ARG_UNPARSED_ARGUMENTS})
   target_link_libraries(${name} PRIVATE ${ARG_LINKS} GTest::gtest GTest::gtest_main)
-  target_compile_definitions(${name} PRIVATE
-    STRATA_DATA_DIR="${STRATA_DATA_DIR}" STRATA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  strata_use_build_paths(${name})  # STRATA_DATA_DIR, STRATA_SOURCE_DIR, STRATA_BINARY
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)  # TempPath.hpp
   strata_set_warnings(${name})
+  strata_unity(${name})
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
 endfunction()

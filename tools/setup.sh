@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs strata's build dependencies from Debian 12 packages (idempotent; run as root or with sudo).
 # Usage: tools/setup.sh                install only
-#        tools/setup.sh --build        install, then configure and build into build/
+#        tools/setup.sh --build        install, then build the `strata` program into build/
 #        tools/setup.sh --sanitizers   install, and fetch the source of libtbb for
 #                                      tools/sanitize.sh tsan (.ci/run does)
 set -euo pipefail
@@ -24,6 +24,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   bzip2 libbz2-dev
   clang libclang-rt-14-dev  # tools/fuzz.sh: libFuzzer and the sanitizer runtimes (clang 14)
+  libcpp-httplib-dev libjs-three                     # strata view: its server, three.js
+  chromium python3-pytest python3-websocket          # strata view's browser tests
+  clang-format              # tools/format.sh (.ci/run checks the formatting)
 )
 
 missing=()
@@ -41,8 +44,34 @@ fi
 
 # The source package of the installed libtbb, for tools/sanitize.sh tsan: ThreadSanitizer needs
 # a libtbb built with it (docs/reliability.md, "Sanitizers"). Fetched here, with the packages, so
-# that builds never download; apt-get checks the files against Debian's signed index. A private
-# source list and state keep the machine's apt configuration untouched.
+# that builds never download; apt-get checks the files against the signed index of the machine's
+# own archives. A private source list and state keep the machine's apt configuration untouched.
+#
+# DebSrcEntries: the machine's apt sources (one-line .list files and deb822 .sources files, at
+# the places apt-config names) as source entries: `deb ...` becomes `deb-src ...`, `Types: deb`
+# becomes `Types: deb-src`. Options, signing keys, suites and components stay as they are.
+DebSrcEntries() {
+  local out=$1 list parts f
+  eval "$(apt-config shell list Dir::Etc::SourceList/f parts Dir::Etc::SourceParts/d)"
+  mkdir -p "$out"
+  for f in "$list" "$parts"*.list; do
+    [[ -f $f ]] || continue
+    sed -n -E 's/^[[:space:]]*deb([[:space:]]+)/deb-src\1/p' "$f" >>"$out/sources.list"
+  done
+  for f in "$parts"*.sources; do
+    [[ -f $f ]] || continue
+    # A stanza whose Types lack deb (deb-src only) is dropped: its lines are kept only when the
+    # stanza, read to its blank line, had `deb` among its types.
+    awk 'function flush() { if (keep) printf "%s", stanza; stanza = ""; keep = 0 }
+         /^[[:space:]]*$/ { flush(); print ""; next }
+         tolower($1) == "types:" {
+           for (i = 2; i <= NF; i++) if ($i == "deb") keep = 1
+           stanza = stanza "Types: deb-src\n"; next }
+         { stanza = stanza $0 "\n" }
+         END { flush() }' "$f" >"$out/$(basename "$f")"
+  done
+}
+
 tbb_version=$(dpkg-query -W -f='${Version}' libtbb-dev)
 tbb_source=${STRATA_TBB_SOURCE_DIR:-/var/cache/strata/onetbb-$tbb_version}
 if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
@@ -51,11 +80,9 @@ if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   apt_dir=$(mktemp -d)
   trap 'rm -rf "$apt_dir"' EXIT
   mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial"
-  {
-    printf 'deb-src http://deb.debian.org/debian %s main\n' bookworm bookworm-updates
-    echo 'deb-src http://deb.debian.org/debian-security bookworm-security main'
-  } >"$apt_dir/sources.list"
-  apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources.list" -o Dir::Etc::SourceParts=/dev/null
+  DebSrcEntries "$apt_dir/sources"
+  apt_opts=(-qq -o "Dir::Etc::SourceList=$apt_dir/sources/sources.list"
+            -o "Dir::Etc::SourceParts=$apt_dir/sources"
             -o "Dir::State::Lists=$apt_dir/lists" -o "Dir::Cache=$apt_dir/cache"
             -o APT::Sandbox::User=root)  # the private folders are not the _apt user's
   "${sudo_cmd[@]}" apt-get "${apt_opts[@]}" update
@@ -63,15 +90,19 @@ if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   (cd "$tbb_source.partial" &&
      "${sudo_cmd[@]}" apt-get "${apt_opts[@]}" source --download-only "onetbb=$tbb_version" \
        >/dev/null 2>&1) || {
-    echo "setup.sh: could not fetch Debian's source package onetbb=$tbb_version" >&2
+    echo "setup.sh: could not fetch Debian's source package onetbb=$tbb_version from the" \
+         "machine's apt sources (as deb-src entries: $apt_dir/sources)" >&2
+    trap - EXIT  # keep them for the user to look at
     exit 1
   }
   "${sudo_cmd[@]}" rm -rf "$tbb_source"
   "${sudo_cmd[@]}" mv "$tbb_source.partial" "$tbb_source"
 fi
 
+# The `strata` program and what it needs, in build/ as tools/test.sh configures it (same
+# settings, ccache), so the test command afterwards compiles only the rest.
 if ((build)); then
   root=$(cd "$(dirname "$0")/.." && pwd)
-  cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release
-  cmake --build "$root/build"
+  "$root/tools/configure.sh"
+  cmake --build "$root/build" --target strata
 fi

@@ -11,10 +11,6 @@ namespace {
 constexpr unsigned long long kMaxDimension = 1ull << 31;
 constexpr unsigned long long kMaxCount = 1ull << 20;
 
-[[noreturn]] void Fail(const std::string& file, size_t line, const std::string& message) {
-    throw std::runtime_error(file + ": header line " + std::to_string(line) + ": " + message);
-}
-
 ScalarType ToScalarType(std::string_view type, unsigned long long size, bool& ok) {
     ok = true;
     if (type == "F" && size == 4) return ScalarType::kF32;
@@ -55,7 +51,8 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
         auto number = [&](unsigned long long max) {
             unsigned long long v = 0;
             if (values.size() != 1 || !ParseUint(values[0], v) || v > max) {
-                Fail(file, n, std::string(key) + " needs one integer up to " + std::to_string(max));
+                FailHeader(file, n,
+                           std::string(key) + " needs one integer up to " + std::to_string(max));
             }
             return v;
         };
@@ -90,20 +87,21 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
             } else if (kind == "binary_compressed") {
                 header.encoding = PcdEncoding::kBinaryCompressed;
             } else {
-                Fail(file, n, "unknown DATA encoding '" + std::string(kind) + "'");
+                FailHeader(file, n, "unknown DATA encoding '" + std::string(kind) + "'");
             }
             has_data = true;
         } else {
-            Fail(file, n, "unknown key '" + std::string(key.substr(0, 32)) + "' (not a PCD file?)");
+            FailHeader(file, n,
+                       "unknown key '" + std::string(key.substr(0, 32)) + "' (not a PCD file?)");
         }
     }
     const size_t n = lines.line_number();
-    if (!has_data) Fail(file, n, "no DATA line: not a PCD file, or the header is truncated");
+    if (!has_data) FailHeader(file, n, "no DATA line: not a PCD file, or the header is truncated");
     const size_t num_fields = header.fields.size();
-    if (num_fields == 0) Fail(file, n, "no FIELDS");
+    if (num_fields == 0) FailHeader(file, n, "no FIELDS");
     if (sizes.size() != num_fields || types.size() != num_fields ||
         (!counts.empty() && counts.size() != num_fields)) {
-        Fail(file, n,
+        FailHeader(file, n,
              std::to_string(num_fields) + " FIELDS but " + std::to_string(sizes.size()) +
                  " SIZE, " + std::to_string(types.size()) + " TYPE and " +
                  std::to_string(counts.size()) + " COUNT entries");
@@ -114,12 +112,13 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
         bool ok = ParseUint(sizes[i], size);
         if (ok) field.type = ToScalarType(types[i], size, ok);
         if (!ok) {
-            Fail(file, n,
+            FailHeader(file, n,
                  "field '" + field.name + "' has unsupported TYPE " + std::string(types[i]) +
                      " with SIZE " + std::string(sizes[i]));
         }
         if (!counts.empty() && (!ParseUint(counts[i], count) || count == 0 || count > kMaxCount)) {
-            Fail(file, n, "field '" + field.name + "' has invalid COUNT " + std::string(counts[i]));
+            FailHeader(file, n,
+                       "field '" + field.name + "' has invalid COUNT " + std::string(counts[i]));
         }
         field.size = static_cast<size_t>(size);
         field.count = static_cast<size_t>(count);
@@ -128,15 +127,15 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
         header.record_size += field.size * field.count;
         header.values_per_point += field.count;
     }
-    if (!has_width) Fail(file, n, "no WIDTH");
+    if (!has_width) FailHeader(file, n, "no WIDTH");
     if (!has_points) points = width * height;
     if (points != width * height) {
-        Fail(file, n,
+        FailHeader(file, n,
              "POINTS " + std::to_string(points) + " disagrees with WIDTH * HEIGHT = " +
                  std::to_string(width) + " * " + std::to_string(height));
     }
     for (const char* axis : {"x", "y", "z"}) {
-        if (header.Find(axis) < 0) Fail(file, n, std::string("no '") + axis + "' field");
+        if (header.Find(axis) < 0) FailHeader(file, n, std::string("no '") + axis + "' field");
     }
     header.width = static_cast<size_t>(width);
     header.height = static_cast<size_t>(height);

@@ -7,10 +7,6 @@
 namespace strata::io::detail {
 namespace {
 
-[[noreturn]] void Fail(const std::string& file, size_t line, const std::string& message) {
-    throw std::runtime_error(file + ": header line " + std::to_string(line) + ": " + message);
-}
-
 bool ToScalarType(std::string_view name, ScalarType& type) {
     struct Entry {
         std::string_view a, b;
@@ -70,7 +66,7 @@ PlyHeader ParsePlyHeader(std::string_view text, const std::string& file) {
         SplitFields(line, words);
         if (words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
         if (words[0] == "end_header") {
-            if (!has_format) Fail(file, n, "no format line");
+            if (!has_format) FailHeader(file, n, "no format line");
             header.data_offset = lines.position();
             header.header_lines = n;
             return header;
@@ -83,7 +79,7 @@ PlyHeader ParsePlyHeader(std::string_view text, const std::string& file) {
             } else if (words[1] == "binary_big_endian") {
                 header.format = PlyFormat::kBinaryBigEndian;
             } else {
-                Fail(file, n, "unknown format '" + std::string(words[1]) + "'");
+                FailHeader(file, n, "unknown format '" + std::string(words[1]) + "'");
             }
             has_format = true;
         } else if (words[0] == "element" && words.size() == 3) {
@@ -91,7 +87,7 @@ PlyHeader ParsePlyHeader(std::string_view text, const std::string& file) {
             element.name = std::string(words[1]);
             unsigned long long count = 0;
             if (!ParseUint(words[2], count)) {
-                Fail(file, n, "bad element count '" + std::string(words[2]) + "'");
+                FailHeader(file, n, "bad element count '" + std::string(words[2]) + "'");
             }
             element.count = count;
             header.elements.push_back(element);
@@ -105,11 +101,11 @@ PlyHeader ParsePlyHeader(std::string_view text, const std::string& file) {
                 ok = ToScalarType(words[2], property.count_type) &&
                      ToScalarType(words[3], property.type);
             }
-            if (!ok) Fail(file, n, "bad property '" + std::string(line.substr(0, 80)) + "'");
+            if (!ok) FailHeader(file, n, "bad property '" + std::string(line.substr(0, 80)) + "'");
             property.name = std::string(words.back());
             header.elements.back().properties.push_back(property);
         } else {
-            Fail(file, n, "unexpected line '" + std::string(line.substr(0, 80)) + "'");
+            FailHeader(file, n, "unexpected line '" + std::string(line.substr(0, 80)) + "'");
         }
     }
     throw std::runtime_error(file + ": no end_header: the PLY header is truncated");

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
@@ -22,12 +23,14 @@ core::Scan ReadPointCloud(const std::filesystem::path& path, const ReadOptions& 
     if (ext == ".pcd") return ReadPcd(path, options);
     if (ext == ".ply") return ReadPly(path, options);
     if (ext == ".las" || ext == ".laz") return ReadLas(path, options);  // ReadLas refuses LAZ
+    if (ext == ".bin") return ReadBin(path, options);  // KITTI .bin, nuScenes .pcd.bin
     // Any .bz2 is compressed text: the octomap example scan is scan.dat.bz2.
     if (ext == ".txt" || ext == ".xyz" || ext == ".csv" || ext == ".dat" || ext == ".bz2") {
         return ReadText(path, options);
     }
-    throw std::invalid_argument(path.string() + ": unknown point cloud extension '" + ext +
-                                "' (expected .pcd, .ply, .las, .txt, .xyz, .csv, .dat or .bz2)");
+    throw InvalidArgumentError(path.string() + ": unknown point cloud extension '" + ext +
+                               "' (expected .pcd, .ply, .las, .bin, .txt, .xyz, .csv, .dat or "
+                               ".bz2)");
 }
 
 }  // namespace strata::io

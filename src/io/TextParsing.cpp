@@ -1,5 +1,7 @@
 #include "TextParsing.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <charconv>
 #include <fstream>
 #include <sstream>
@@ -7,6 +9,10 @@
 #include <system_error>
 
 namespace strata::io::detail {
+
+void FailHeader(const std::string& file, size_t line, const std::string& message) {
+    throw FormatError(file + ": header line " + std::to_string(line) + ": " + message);
+}
 
 std::string ReadTextFile(const std::filesystem::path& path) {
     std::error_code ec;

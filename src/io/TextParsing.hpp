@@ -14,6 +14,9 @@ namespace strata::io::detail {
 /// @brief Reads a whole text file; throws std::runtime_error naming it on failure.
 [[nodiscard]] std::string ReadTextFile(const std::filesystem::path& path);
 
+/// @brief Throws FormatError "<file>: header line <line>: <message>" (PCD and PLY headers).
+[[noreturn]] void FailHeader(const std::string& file, size_t line, const std::string& message);
+
 /// @brief Parses the whole token as a double ("1.5", "-2e3", "+4", "nan"); false otherwise.
 [[nodiscard]] bool ParseDouble(std::string_view token, double& value);
 

@@ -81,6 +81,13 @@ void WriteSeeds(const fs::path& out) {
     io::WriteKittiLabels(scratch / "a.label", {10, 40 | 5u << 16, 70});
     Seed(out, "kitti", "scan.bin", Slurp(scratch / "a.bin"));
     Seed(out, "kitti", "scan.label", Slurp(scratch / "a.label"));
+    // Raw .bin: the first byte picks name and field count (FuzzBin.cpp): inferred KITTI (0),
+    // nuScenes by name (4), KITTI given (1), and five floats per point given (2).
+    const std::string bin = Slurp(scratch / "a.bin");
+    for (const char mode : {'\0', '\4', '\1'}) {
+        Seed(out, "bin", "mode" + std::to_string(int{mode}) + ".bin", std::string(1, mode) + bin);
+    }
+    Seed(out, "bin", "five.bin", std::string(1, '\2') + bin.substr(0, 40));
     // PCD, PLY, LAS: the reader tests' builders.
     for (const char* encoding : {"ascii", "binary", "binary_compressed"}) {
         Seed(out, "pcd", std::string(encoding) + ".pcd", MakePcd(encoding));

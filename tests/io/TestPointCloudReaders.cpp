@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ReaderTestFiles.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
@@ -324,7 +325,7 @@ TEST(TextReader, ReportsBadLinesAndBrokenBzip2NamingTheFile) {
                     dir / "crc.txt.bz2", "bzip2");
     ExpectReadError([&] { return ReadText(text_file("plain.bz2", "1 2 3\n")); }, dir / "plain.bz2",
                     "not bzip2");
-    EXPECT_THROW(static_cast<void>(ReadPointCloud(dir / "cloud.obj")), std::invalid_argument);
+    EXPECT_THROW(static_cast<void>(ReadPointCloud(dir / "cloud.obj")), InvalidArgumentError);
 }
 
 TEST(TextReader, ReadsRealOctomapScan) {

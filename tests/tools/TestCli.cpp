@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "CliTestUtil.hpp"
+#include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
 #include "strata/store/MapStore.hpp"
 
@@ -158,6 +159,41 @@ TEST(Cli, SimulatedSequenceIntegratesEndToEnd) {
     const Result bad = Strata("simulate --scene /nonexistent/scene.json --out " + seq.string());
     EXPECT_NE(bad.code, 0);
     EXPECT_NE(bad.out.find("/nonexistent/scene.json"), std::string::npos) << bad.out;
+}
+
+TEST(Cli, IntegratesRawBinScansAndRefusesAmbiguousOnesWithoutChangingTheMap) {
+    const fs::path dir = Temp("bin");
+    fs::create_directories(dir);
+    std::vector<Eigen::Vector3d> wall;  // 41 x 21 = 861 points: 13776 bytes, only 16 divides
+    for (int i = -20; i <= 20; ++i) {
+        for (int j = -10; j <= 10; ++j) wall.emplace_back(4.0, 0.1 * i, 0.1 * j);
+    }
+    strata::io::WriteKittiBin(dir / "000000.bin", wall, {});
+    const fs::path map = Temp("binmap");
+    const Result r = Strata("integrate " + map.string() + " --scans " +
+                            (dir / "000000.bin").string() + " --voxel 0.1");
+    ASSERT_EQ(r.code, 0) << r.out;
+    {
+        const MapStore store = OpenForReading(map);
+        const auto loaded = store.LoadMap(store.Latest());
+        EXPECT_GT(loaded.occupancy->tree().getValue(loaded.WorldToVoxel({4.05, 0.05, 0.05})), 0.f);
+    }
+    const auto before = MapFiles(map);
+    // 5 points = 80 bytes: 5 KITTI points or 4 nuScenes points. Refused, naming the file.
+    strata::io::WriteKittiBin(dir / "000001.bin", {wall.begin(), wall.begin() + 5}, {});
+    const Result ambiguous = Strata("integrate " + map.string() + " --scans " +
+                                    (dir / "000001.bin").string());
+    EXPECT_EQ(ambiguous.code, 6) << ambiguous.out;  // bad format
+    EXPECT_NE(ambiguous.out.find("000001.bin"), std::string::npos) << ambiguous.out;
+    EXPECT_NE(ambiguous.out.find("--bin-fields"), std::string::npos) << ambiguous.out;
+    EXPECT_EQ(MapFiles(map), before);
+    EXPECT_EQ(Strata("integrate " + map.string() + " --scans " + (dir / "000001.bin").string() +
+                     " --bin-fields 3").code, 2);  // usage
+    EXPECT_EQ(MapFiles(map), before);
+    const Result given = Strata("integrate " + map.string() + " --scans " +
+                                (dir / "000001.bin").string() + " --bin-fields 4");
+    EXPECT_EQ(given.code, 0) << given.out;
+    EXPECT_EQ(OpenForReading(map).Latest().sessions.size(), 2u);
 }
 
 }  // namespace

@@ -18,5 +18,6 @@ void RegisterWalls(CLI::App& app);
 void RegisterVehicles(CLI::App& app);
 void RegisterRegister(CLI::App& app);
 void RegisterFloors(CLI::App& app);
+void RegisterView(CLI::App& app);
 
 }  // namespace strata::tools

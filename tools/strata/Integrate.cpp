@@ -22,6 +22,7 @@ struct IntegrateArgs {
     std::string frames;
     std::vector<std::string> scans;
     std::string poses;
+    int bin_fields = 0;  // --bin-fields; 0: from the name or size
     std::string name;
     std::vector<double> origin;
     double voxel = 0.2;
@@ -43,6 +44,7 @@ void Integrate(const IntegrateArgs& args, store::MapStore& map, bool existed) {
     const store::MapSettings& settings = map.settings();
     io::ReadOptions read_options;
     read_options.origin = settings.origin;
+    read_options.bin_fields = args.bin_fields;
     const ScanSource source =
         args.kitti.empty()
             ? ScanSource::Files({args.scans.begin(), args.scans.end()}, args.poses, read_options)
@@ -151,7 +153,8 @@ void RegisterIntegrate(CLI::App& app) {
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     cmd->add_option("--kitti", args->kitti, "KITTI/SemanticKITTI sequence folder");
     cmd->add_option("--frames", args->frames, "Frame range A:B of the sequence (half-open)");
-    cmd->add_option("--scans", args->scans, "PCD, PLY, LAS or text files (.bz2 allowed)");
+    cmd->add_option("--scans", args->scans, "PCD, PLY, LAS, .bin or text files (.bz2 allowed)");
+    AddBinFieldsOption(*cmd, args->bin_fields);
     cmd->add_option("--poses", args->poses, "Pose file for --scans (KITTI 3x4 or TUM), by index");
     cmd->add_option("--name", args->name, "Session name");
     cmd->add_option("--origin", args->origin, "Map origin x,y,z for a new map (georeferenced data)")

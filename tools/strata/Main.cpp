@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
     strata::tools::RegisterFloors(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
+    strata::tools::RegisterView(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

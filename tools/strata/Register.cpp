@@ -16,6 +16,7 @@ struct RegisterArgs {
     std::string frames;
     std::vector<std::string> scans;
     std::string poses;
+    int bin_fields = 0;  // --bin-fields; 0: from the name or size
     std::string as_of;
     bool json = false;
     AlignArgs align;
@@ -28,6 +29,7 @@ void Run(const RegisterArgs& args) {
     const store::MapStore map = OpenMap(args.map);
     io::ReadOptions read_options;
     read_options.origin = map.settings().origin;
+    read_options.bin_fields = args.bin_fields;
     const ScanSource source =
         args.kitti.empty()
             ? ScanSource::Files({args.scans.begin(), args.scans.end()}, args.poses, read_options)
@@ -67,7 +69,8 @@ void RegisterRegister(CLI::App& app) {
     cmd->add_option("MAP", args->map, "Map directory")->required();
     cmd->add_option("--kitti", args->kitti, "KITTI/SemanticKITTI sequence folder");
     cmd->add_option("--frames", args->frames, "Frame range A:B of the sequence (half-open)");
-    cmd->add_option("--scans", args->scans, "PCD, PLY, LAS or text files (.bz2 allowed)");
+    cmd->add_option("--scans", args->scans, "PCD, PLY, LAS, .bin or text files (.bz2 allowed)");
+    AddBinFieldsOption(*cmd, args->bin_fields);
     cmd->add_option("--poses", args->poses, "Pose file for --scans (KITTI 3x4 or TUM), by index");
     cmd->add_option("--as-of", args->as_of, "Align to the map as of this session");
     cmd->add_flag("--json", args->json, "Print the result as JSON");

@@ -1,5 +1,6 @@
 #include "ScanSource.hpp"
 
+#include <CLI/CLI.hpp>
 #include <stdexcept>
 
 #include "Progress.hpp"
@@ -9,6 +10,14 @@
 namespace strata::tools {
 
 namespace fs = std::filesystem;
+
+void AddBinFieldsOption(CLI::App& cmd, int& bin_fields) {
+    cmd.add_option("--bin-fields", bin_fields,
+                   "float32 values per point of .bin scans: 4 (KITTI: x y z intensity) or 5 "
+                   "(nuScenes: x y z intensity ring); default: 5 for *.pcd.bin, else the one "
+                   "that divides the file size")
+        ->check(CLI::IsMember({4, 5}));
+}
 
 namespace {
 

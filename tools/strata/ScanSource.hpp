@@ -12,7 +12,14 @@
 #include "strata/io/PointCloudReaders.hpp"
 #include "strata/store/SessionWriter.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace strata::tools {
+
+/// Adds --bin-fields to a command that reads --scans: float32 values per point of raw .bin scans.
+void AddBinFieldsOption(CLI::App& cmd, int& bin_fields);
 
 class ScanSource {
 public:

@@ -1,6 +1,6 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
+#include "strata/core/GridTypes.hpp"
 
 #include <Eigen/Core>
 #include <string>

@@ -15,10 +15,15 @@ struct ReadOptions {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
     /// nullptr: the format's default (SemanticKITTI ids for PCD/PLY/text, LAS classes for LAS).
     const core::LabelMapping* mapping = nullptr;
+    /// float32 values per point of a raw `.bin` scan: 4 (KITTI: x y z intensity), 5 (nuScenes:
+    /// x y z intensity ring) or 0: 5 for names ending in `.pcd.bin`, else from the file size
+    /// when exactly one of 4 and 5 divides it (ReadBin refuses the file when both or neither do).
+    int bin_fields = 0;
 };
 
-/// @brief Reads a point cloud chosen by extension: .pcd, .ply, .las, text (.txt .xyz .csv .dat)
-/// and bzip2-compressed text (any name ending in .bz2).
+/// @brief Reads a point cloud chosen by extension: .pcd, .ply, .las, raw float32 .bin (KITTI,
+/// nuScenes .pcd.bin), text (.txt .xyz .csv .dat) and bzip2-compressed text (any name ending in
+/// .bz2).
 /// @return a Scan at the identity pose, `time_s` 0 and `source` = path. Points are in the file's
 /// frame minus `options.origin`. Non-finite points are dropped (PCD also drops (0,0,0), which
 /// organised clouds use for missing returns).
@@ -38,6 +43,13 @@ struct ReadOptions {
 /// optional label (`label`, `class`, `classification`) and intensity (`intensity`,
 /// `scalar_intensity`, `reflectance`); other elements and properties, lists included, are skipped.
 [[nodiscard]] core::Scan ReadPly(const std::filesystem::path& path,
+                                 const ReadOptions& options = {});
+
+/// @brief Raw little-endian float32 records, `options.bin_fields` per point (see ReadOptions):
+/// x y z intensity [ring]; the ring is skipped. An empty file is a scan without points.
+/// @throws InvalidArgumentError for a field count other than 0, 4 or 5; FormatError naming the
+/// file when its size is not a whole number of records, or fits both counts and none was given.
+[[nodiscard]] core::Scan ReadBin(const std::filesystem::path& path,
                                  const ReadOptions& options = {});
 
 /// @brief Uncompressed LAS 1.0-1.4, point formats 0-10. Labels are the classification codes

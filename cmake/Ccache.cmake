@@ -1,0 +1,13 @@
+# Every build directory compiles through ccache when it is installed, with the same settings
+# whoever configures it (tools/setup.sh, tools/test.sh, the sanitizer scripts, an IDE), so the
+# README's two commands share their objects and clones in other folders share the cache.
+# CCACHE_BASEDIR=<source root> makes ccache hash the paths under it relative to the build
+# directory. -DSTRATA_CCACHE=OFF, or a CMAKE_CXX_COMPILER_LAUNCHER of your own, opts out.
+option(STRATA_CCACHE "Compile through ccache when it is installed" ON)
+if(STRATA_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
+  find_program(STRATA_CCACHE_PROGRAM ccache)
+  if(STRATA_CCACHE_PROGRAM)
+    set(CMAKE_CXX_COMPILER_LAUNCHER env CCACHE_BASEDIR=${PROJECT_SOURCE_DIR}
+                                    ${STRATA_CCACHE_PROGRAM})
+  endif()
+endif()
