@@ -78,6 +78,21 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
     echo
     "$build/bench/bench_vehicles" "$root/../shared/data"
   fi
+  if [[ -x "$build/bench/bench_registration" ]]; then
+    echo
+    echo "## Registration (\`bench/bench_registration\`)"
+    echo
+    echo "One core (TBB limited to 1), maps integrated in memory outside the timing. First table:"
+    echo "time per registration with its error (KITTI 00 against the raw-point optimum of"
+    echo "[registration.md](registration.md#real-scans-strata-against-the-raw-point-optimum), BALM's"
+    echo "second half against its unmoved alignment composed with the known move, the building"
+    echo "against the simulator's poses). Second table: every real pair, strata"
+    echo "(map of scan A, scan B from 0.5 m / 3 deg off) with 6000 and with 20000 (the default)"
+    echo "source points at the finest level beside the plain raw-point ICP it is measured"
+    echo "against; the program exits 1 when a pair misses 0.05 deg."
+    echo
+    "$build/bench/bench_registration" "$root/../shared/data" --repeat 3
+  fi
   if [[ -x "$build/bench/bench_viewer" ]]; then
     echo
     echo "## Viewer (\`bench/bench_viewer\`, \`bench/bench_viewer_page.py\`)"

@@ -1,4 +1,5 @@
 #include "strata/change/ChangeDetection.hpp"
+#include "strata/core/Error.hpp"
 
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
@@ -130,7 +131,7 @@ size_t ObservedOnlyBy(const core::OccupancyMasks& a, const core::OccupancyMasks&
 
 void Require(const Observation& o, const char* side) {
     if (!o.masks.occupied || !o.masks.free) {
-        throw std::invalid_argument(std::string("change detection: side ") + side +
+        throw InvalidArgumentError(std::string("change detection: side ") + side +
                                     " has no occupied/free masks");
     }
 }
@@ -145,7 +146,7 @@ ChangeSet DetectChanges(const Observation& a, const Observation& b, double voxel
                         const ChangeQuery& query) {
     Require(a, "A");
     Require(b, "B");
-    if (!(voxel_size > 0.0)) throw std::invalid_argument("change detection: voxel size <= 0");
+    if (!(voxel_size > 0.0)) throw InvalidArgumentError("change detection: voxel size <= 0");
 
     const core::OccupancyMasks ra = InRegion(a.masks, query, voxel_size);
     const core::OccupancyMasks rb = InRegion(b.masks, query, voxel_size);

@@ -1,4 +1,5 @@
 #include "strata/change/MapObserver.hpp"
+#include "strata/core/Error.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -91,7 +92,7 @@ Observation MapObserver::Map(const store::Snapshot& snapshot) {
 }
 
 Observation ObserveMap(const core::VoxelMap& map) {
-    if (!map.occupancy) throw std::invalid_argument("change detection: map without occupancy");
+    if (!map.occupancy) throw InvalidArgumentError("change detection: map without occupancy");
     return Observation{core::SplitOccupancy(*map.occupancy), map.label};
 }
 

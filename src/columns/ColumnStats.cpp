@@ -1,4 +1,5 @@
 #include "strata/columns/ColumnStats.hpp"
+#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -69,7 +70,7 @@ ColumnGrid ColumnGrid::Allocate(const openvdb::CoordBBox& columns) {
 }
 
 ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map) {
-    if (!map.occupancy) throw std::invalid_argument("column statistics: the map has no occupancy");
+    if (!map.occupancy) throw InvalidArgumentError("column statistics: the map has no occupancy");
     openvdb::CoordBBox box;
     for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
         if (*it <= 0.0f) continue;
@@ -102,7 +103,7 @@ ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map) {
 ColumnGrid ColumnGrid::FromVoxels(const std::vector<openvdb::Coord>& voxels,
                                   const std::vector<int32_t>& points) {
     if (!points.empty() && points.size() != voxels.size()) {
-        throw std::invalid_argument("column statistics: one point count per voxel expected");
+        throw InvalidArgumentError("column statistics: one point count per voxel expected");
     }
     openvdb::CoordBBox box;
     for (const openvdb::Coord& v : voxels) box.expand(v);
@@ -125,7 +126,7 @@ size_t ColumnGrid::OccupiedColumns() const {
 }
 
 ColumnGrid ColumnGrid::Window(int radius) const {
-    if (radius < 0) throw std::invalid_argument("column window: the radius must be >= 0");
+    if (radius < 0) throw InvalidArgumentError("column window: the radius must be >= 0");
     ColumnGrid out = *this;
     if (empty() || radius == 0) return out;
     const int w = width_, h = height_;

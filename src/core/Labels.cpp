@@ -1,5 +1,7 @@
 #include "strata/core/Labels.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -41,7 +43,7 @@ SemanticClass ClassFromName(const std::string& name) {
     for (size_t i = 0; i < kClasses.size(); ++i) {
         if (name == kClasses[i].name) return static_cast<SemanticClass>(i);
     }
-    throw std::invalid_argument("unknown semantic class '" + name + "'");
+    throw InvalidArgumentError("unknown semantic class '" + name + "'");
 }
 
 std::string LegendJson() {

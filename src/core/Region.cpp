@@ -1,5 +1,7 @@
 #include "strata/core/Region.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -9,7 +11,7 @@ namespace strata::core {
 Region Region::Box(double x0, double y0, double x1, double y1) {
     if (!(std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) && std::isfinite(y1)) ||
         !(x0 < x1) || !(y0 < y1)) {
-        throw std::invalid_argument("a region box needs finite x0 < x1 and y0 < y1");
+        throw InvalidArgumentError("a region box needs finite x0 < x1 and y0 < y1");
     }
     Region r = Polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
     r.is_box_ = true;
@@ -17,16 +19,16 @@ Region Region::Box(double x0, double y0, double x1, double y1) {
 }
 
 Region Region::Polygon(std::vector<Eigen::Vector2d> vertices) {
-    if (vertices.size() < 3) throw std::invalid_argument("a region polygon needs 3 vertices");
+    if (vertices.size() < 3) throw InvalidArgumentError("a region polygon needs 3 vertices");
     Region r;
     r.min_ = r.max_ = vertices.front();
     for (const Eigen::Vector2d& v : vertices) {
-        if (!v.allFinite()) throw std::invalid_argument("a region vertex is not finite");
+        if (!v.allFinite()) throw InvalidArgumentError("a region vertex is not finite");
         r.min_ = r.min_.cwiseMin(v);
         r.max_ = r.max_.cwiseMax(v);
     }
     if (!(r.min_.x() < r.max_.x()) || !(r.min_.y() < r.max_.y())) {
-        throw std::invalid_argument("a region polygon must enclose an area");
+        throw InvalidArgumentError("a region polygon must enclose an area");
     }
     r.vertices_ = std::move(vertices);
     return r;
@@ -45,12 +47,12 @@ Region Region::Parse(const std::string& text) {
             used = 0;
         }
         if (used == 0 || item.find_first_not_of(" \t", used) != std::string::npos) {
-            throw std::invalid_argument("region '" + text + "': '" + item + "' is not a number");
+            throw InvalidArgumentError("region '" + text + "': '" + item + "' is not a number");
         }
         values.push_back(v);
     }
     const auto bad = [&](const std::string& why) {
-        return std::invalid_argument("region '" + text + "': " + why +
+        return InvalidArgumentError("region '" + text + "': " + why +
                                      " (expected x0,y0,x1,y1 or a polygon x0,y0,x1,y1,x2,y2,...)");
     };
     try {
@@ -60,7 +62,7 @@ Region Region::Parse(const std::string& text) {
         for (size_t i = 0; i < values.size(); i += 2)
             vertices.emplace_back(values[i], values[i + 1]);
         return Polygon(std::move(vertices));
-    } catch (const std::invalid_argument& e) {
+    } catch (const InvalidArgumentError& e) {
         if (std::string(e.what()).rfind("region '", 0) == 0) throw;
         throw bad(e.what());
     }

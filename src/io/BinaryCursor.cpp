@@ -1,30 +1,30 @@
 #include "BinaryCursor.hpp"
 
+#include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
+
 #include <algorithm>
+#include <cerrno>
 #include <fstream>
-#include <stdexcept>
-#include <system_error>
 
 namespace strata::io::detail {
 
 std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path, size_t max_bytes,
                                    size_t* file_size) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
-        throw std::runtime_error(path.string() + ": is a directory, expected a file");
-    }
+    RequireFile(path);
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path.string() + ": cannot open file for reading");
+    if (!in) FailOpen(path);
     in.seekg(0, std::ios::end);
     const std::streamoff size = in.tellg();
-    if (size < 0) throw std::runtime_error(path.string() + ": cannot determine the file size");
+    if (size < 0) throw IoError(path.string() + ": cannot determine the file size");
     in.seekg(0, std::ios::beg);
     if (file_size != nullptr) *file_size = static_cast<size_t>(size);
     const size_t wanted = std::min(static_cast<size_t>(size), max_bytes);
     std::vector<uint8_t> bytes(wanted);
     if (wanted > 0 &&
         !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(wanted))) {
-        throw std::runtime_error(path.string() + ": read error after " +
+        throw IoError(path.string() + ": read error after " +
                                  std::to_string(in.gcount()) + " of " + std::to_string(wanted) +
                                  " bytes");
     }
@@ -86,7 +86,7 @@ void BinaryCursor::Seek(size_t pos, const char* what) {
 }
 
 void BinaryCursor::Fail(const std::string& message) const {
-    throw std::runtime_error(file_ + ": " + message);
+    throw FormatError(file_ + ": " + message);
 }
 
 void BinaryCursor::FailTruncated(size_t n, const char* what) const {

@@ -14,8 +14,8 @@
 
 namespace strata::io::detail {
 
-/// @brief Reads a file (at most its first `max_bytes`) into memory; throws std::runtime_error
-/// naming it on failure. `file_size`, when given, receives the size of the whole file.
+/// @brief Reads a file (at most its first `max_bytes`) into memory; throws the errors of
+/// RequireFile/FailOpen (TextParsing.hpp) or IoError naming it. `file_size`, when given, receives the size of the whole file.
 [[nodiscard]] std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path,
                                                  size_t max_bytes = SIZE_MAX,
                                                  size_t* file_size = nullptr);
@@ -88,7 +88,7 @@ public:
         return LoadScalar<T>(Take(sizeof(T), what), big_endian);
     }
 
-    /// @brief Throws std::runtime_error "<file>: <message>".
+    /// @brief Throws FormatError "<file>: <message>".
     [[noreturn]] void Fail(const std::string& message) const;
 
 private:

@@ -7,18 +7,19 @@
 #include <string>
 
 #include "strata/core/Labels.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/core/VoxelMap.hpp"
 
 // What every exporter reads from a map: the checked grids, the class of a label value, and the
 // observed voxels with active tiles expanded (a pruned map stores uniform free space as tiles).
 namespace strata::io::detail {
 
-/// @brief Throws std::invalid_argument unless the map has all grids and a voxel size.
+/// @brief Throws InvalidArgumentError unless the map has all grids and a voxel size.
 /// @param target what is being exported, for the message ("'out/map.ply'").
 inline void RequireGrids(const core::VoxelMap& map, const std::string& target) {
     if (!map.occupancy || !map.label || !map.label_weight || !map.endpoints ||
         !(map.voxel_size > 0.0)) {
-        throw std::invalid_argument("cannot export " + target +
+        throw InvalidArgumentError("cannot export " + target +
                                     ": the map is not initialised (use VoxelMap::Create)");
     }
 }

@@ -1,4 +1,5 @@
 #include "strata/io/Image.hpp"
+#include "strata/core/Error.hpp"
 
 #include <png.h>
 
@@ -68,7 +69,7 @@ void DrawText(RgbImage& image, int x0, int y0, const std::string& text, int scal
 }  // namespace
 
 core::Rgb Ramp(const std::vector<core::Rgb>& stops, double t) {
-    if (stops.size() < 2) throw std::invalid_argument("a colour ramp needs at least 2 stops");
+    if (stops.size() < 2) throw InvalidArgumentError("a colour ramp needs at least 2 stops");
     const int last = static_cast<int>(stops.size()) - 1;
     const double x = std::clamp(t, 0.0, 1.0) * last;
     const int k = std::min(last - 1, static_cast<int>(x));
@@ -101,7 +102,7 @@ std::string LengthLabel(int mantissa, int exponent) {
 
 RgbImage::RgbImage(int width, int height, core::Rgb fill) : width_(width), height_(height) {
     if (width <= 0 || height <= 0) {
-        throw std::invalid_argument("image size must be positive, got " + std::to_string(width) +
+        throw InvalidArgumentError("image size must be positive, got " + std::to_string(width) +
                                     " x " + std::to_string(height));
     }
     pixels_.resize(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
@@ -134,7 +135,7 @@ void RgbImage::FillRect(int x0, int y0, int w, int h, core::Rgb color) {
 
 void DrawScaleBar(RgbImage& image, double meters_per_pixel) {
     if (!(meters_per_pixel > 0.0) || !std::isfinite(meters_per_pixel)) {
-        throw std::invalid_argument("scale bar: meters per pixel must be positive");
+        throw InvalidArgumentError("scale bar: meters per pixel must be positive");
     }
     const int scale = image.width() >= 600 ? 2 : 1;
     if (image.width() < 48 * scale || image.height() < 24 * scale) return;
@@ -166,7 +167,7 @@ void DrawScaleBar(RgbImage& image, double meters_per_pixel) {
 
 void WritePng(const RgbImage& image, const std::filesystem::path& path) {
     if (image.width() <= 0 || image.height() <= 0) {
-        throw std::invalid_argument("cannot write an empty image to '" + path.string() + "'");
+        throw InvalidArgumentError("cannot write an empty image to '" + path.string() + "'");
     }
     png_image png{};
     png.version = PNG_IMAGE_VERSION;
@@ -186,7 +187,7 @@ void WritePng(const RgbImage& image, const std::filesystem::path& path) {
     if (!ok) {
         const std::string message = png.message;
         png_image_free(&png);
-        throw std::runtime_error("cannot encode PNG '" + path.string() + "': " + message);
+        throw IoError("cannot encode PNG '" + path.string() + "': " + message);
     }
     WriteFileAtomically(path, [&](std::ostream& os) {
         os.write(reinterpret_cast<const char*>(encoded.data()), static_cast<std::streamsize>(size));
@@ -197,7 +198,7 @@ RgbImage ReadPng(const std::filesystem::path& path) {
     png_image png{};
     png.version = PNG_IMAGE_VERSION;
     if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {
-        throw std::runtime_error("cannot read PNG '" + path.string() + "': " + png.message);
+        throw IoError("cannot read PNG '" + path.string() + "': " + png.message);
     }
     png.format = PNG_FORMAT_RGB;
     RgbImage image(static_cast<int>(png.width), static_cast<int>(png.height));
@@ -205,7 +206,7 @@ RgbImage ReadPng(const std::filesystem::path& path) {
     if (png_image_finish_read(&png, nullptr, image.pixels_.data(), 0, nullptr) == 0) {
         const std::string message = png.message;
         png_image_free(&png);
-        throw std::runtime_error("cannot decode PNG '" + path.string() + "': " + message);
+        throw FormatError("cannot decode PNG '" + path.string() + "': " + message);
     }
     return image;
 }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "BinaryCursor.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/KittiSequence.hpp"
 
 namespace strata::io {
@@ -24,10 +25,10 @@ void AppendFloat(std::string& out, float v) {
 
 void WriteBytes(const std::filesystem::path& path, const std::string& bytes) {
     std::ofstream out(path, std::ios::binary);
-    if (!out) throw std::runtime_error(path.string() + ": cannot open file for writing");
+    if (!out) throw IoError(path.string() + ": cannot open file for writing");
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.close();
-    if (!out) throw std::runtime_error(path.string() + ": write error");
+    if (!out) throw IoError(path.string() + ": write error");
 }
 
 }  // namespace
@@ -68,7 +69,7 @@ std::vector<uint32_t> ReadKittiLabels(const std::filesystem::path& path) {
 void WriteKittiBin(const std::filesystem::path& path, const std::vector<Eigen::Vector3d>& points,
                    const std::vector<float>& intensity) {
     if (!intensity.empty() && intensity.size() != points.size()) {
-        throw std::invalid_argument(path.string() + ": " + std::to_string(intensity.size()) +
+        throw InvalidArgumentError(path.string() + ": " + std::to_string(intensity.size()) +
                                     " intensities for " + std::to_string(points.size()) +
                                     " points");
     }

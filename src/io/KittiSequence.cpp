@@ -1,4 +1,5 @@
 #include "strata/io/KittiSequence.hpp"
+#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -29,7 +30,7 @@ std::vector<ScanFile> ListScans(const fs::path& velodyne) {
             scans.push_back({it->path(), 0});
         }
     }
-    if (ec) throw std::runtime_error(velodyne.string() + ": cannot list: " + ec.message());
+    if (ec) throw IoError(velodyne.string() + ": cannot list: " + ec.message());
     std::sort(scans.begin(), scans.end(),
               [](const ScanFile& a, const ScanFile& b) { return a.path < b.path; });
     bool numeric = true;
@@ -56,21 +57,21 @@ std::vector<ScanFile> ListScans(const fs::path& velodyne) {
 KittiSequence OpenKittiSequence(const fs::path& dir) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
-        throw std::runtime_error(dir.string() + ": not a directory (expected a KITTI sequence)");
+        throw NotFoundError(dir.string() + ": not a directory (expected a KITTI sequence)");
     }
     const fs::path velodyne = dir / "velodyne";
     if (!fs::is_directory(velodyne, ec)) {
-        throw std::runtime_error(velodyne.string() +
+        throw NotFoundError(velodyne.string() +
                                  ": missing (KITTI layout: velodyne/NNNNNN.bin)");
     }
     const std::vector<ScanFile> scans = ListScans(velodyne);
-    if (scans.empty()) throw std::runtime_error(velodyne.string() + ": holds no .bin scans");
+    if (scans.empty()) throw NotFoundError(velodyne.string() + ": holds no .bin scans");
     const size_t frames_needed = scans.back().frame + 1;
 
     const fs::path poses_txt = dir / "poses.txt";
     const std::vector<Eigen::Isometry3d> poses = ReadKittiPoses(poses_txt);
     if (poses.size() < frames_needed) {
-        throw std::runtime_error(poses_txt.string() + ": " + std::to_string(poses.size()) +
+        throw FormatError(poses_txt.string() + ": " + std::to_string(poses.size()) +
                                  " poses, but the sequence has " + std::to_string(scans.size()) +
                                  " scans up to frame " + std::to_string(frames_needed - 1) +
                                  ", which needs " + std::to_string(frames_needed));
@@ -84,7 +85,7 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
     if (fs::exists(times_txt, ec)) {
         times = ReadTimes(times_txt);
         if (times.size() < frames_needed) {
-            throw std::runtime_error(times_txt.string() + ": " + std::to_string(times.size()) +
+            throw FormatError(times_txt.string() + ": " + std::to_string(times.size()) +
                                      " timestamps, but frames up to " +
                                      std::to_string(frames_needed - 1) + " need " +
                                      std::to_string(frames_needed));
@@ -104,7 +105,7 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
         fs::path label = labels_dir / s.path.stem();
         label += ".label";
         if (!fs::is_regular_file(label, ec)) {
-            throw std::runtime_error(label.string() +
+            throw NotFoundError(label.string() +
                                      ": missing; labels/ must hold one .label "
                                      "per scan (" +
                                      std::to_string(scans.size()) + " scans)");
@@ -116,7 +117,7 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
 
 core::Scan ReadKittiScan(const KittiSequence& seq, size_t index) {
     if (index >= seq.size()) {
-        throw std::invalid_argument("ReadKittiScan: index " + std::to_string(index) +
+        throw InvalidArgumentError("ReadKittiScan: index " + std::to_string(index) +
                                     " out of range for " + std::to_string(seq.size()) + " scans");
     }
     const fs::path& bin = seq.scan_files[index];
@@ -131,7 +132,7 @@ core::Scan ReadKittiScan(const KittiSequence& seq, size_t index) {
         const fs::path& label_file = seq.label_files.at(index);
         const std::vector<uint32_t> labels = ReadKittiLabels(label_file);
         if (labels.size() != scan.points.size()) {
-            throw std::runtime_error(label_file.string() + ": " + std::to_string(labels.size()) +
+            throw FormatError(label_file.string() + ": " + std::to_string(labels.size()) +
                                      " labels for " + std::to_string(scan.points.size()) +
                                      " points in " + bin.string());
         }

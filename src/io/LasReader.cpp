@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "BinaryCursor.hpp"
+#include "strata/core/Error.hpp"
 #include "ScanBuilder.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
@@ -82,7 +83,7 @@ LasHeader ParseLasHeader(detail::BinaryCursor& c, size_t file_size) {
 }
 
 [[noreturn]] void RefuseLaz(const std::string& file) {
-    throw std::runtime_error(file +
+    throw FormatError(file +
                              ": LAZ (compressed LAS) is not supported; decompress it first, e.g. "
                              "`pdal translate in.laz out.las` or `laszip -i in.laz -o out.las`");
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "strata/io/PoseFiles.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::io {
 namespace {
@@ -19,7 +20,7 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
                                           const std::vector<double>& scan_times_s,
                                           double max_dt_s) {
     if (!(max_dt_s >= 0.0)) {
-        throw std::invalid_argument("MatchPoses: max_dt_s must be >= 0, got " +
+        throw InvalidArgumentError("MatchPoses: max_dt_s must be >= 0, got " +
                                     std::to_string(max_dt_s));
     }
     const size_t stamped = static_cast<size_t>(std::count_if(
@@ -30,7 +31,7 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
     // Poses without timestamps (KITTI): the i-th pose belongs to the i-th scan.
     if (stamped == 0) {
         if (poses.size() < scan_times_s.size()) {
-            throw std::runtime_error(ScanName(poses.size(), scan_times_s[poses.size()]) +
+            throw FormatError(ScanName(poses.size(), scan_times_s[poses.size()]) +
                                      " has no pose: " + std::to_string(poses.size()) +
                                      " poses for " + std::to_string(scan_times_s.size()) +
                                      " scans");
@@ -39,7 +40,7 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
         return matched;
     }
     if (stamped != poses.size()) {
-        throw std::invalid_argument("MatchPoses: only " + std::to_string(stamped) + " of " +
+        throw InvalidArgumentError("MatchPoses: only " + std::to_string(stamped) + " of " +
                                     std::to_string(poses.size()) + " poses have timestamps");
     }
 
@@ -50,7 +51,7 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
               [&](size_t a, size_t b) { return poses[a].time_s < poses[b].time_s; });
     for (size_t i = 0; i < scan_times_s.size(); ++i) {
         const double t = scan_times_s[i];
-        if (!std::isfinite(t)) throw std::runtime_error(ScanName(i, t) + " has no finite time");
+        if (!std::isfinite(t)) throw FormatError(ScanName(i, t) + " has no finite time");
         const auto it = std::lower_bound(order.begin(), order.end(), t,
                                          [&](size_t k, double v) { return poses[k].time_s < v; });
         size_t best = order.size();  // index into `order`
@@ -65,7 +66,7 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
             }
         }
         if (best_dt > max_dt_s) {
-            throw std::runtime_error(
+            throw FormatError(
                 ScanName(i, t) + " has no pose within " + std::to_string(max_dt_s) +
                 " s: the nearest is at t = " + std::to_string(poses[order[best]].time_s) + " s");
         }

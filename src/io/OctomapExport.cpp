@@ -1,4 +1,5 @@
 #include "strata/io/OctomapExport.hpp"
+#include "strata/core/Error.hpp"
 
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
@@ -48,7 +49,7 @@ void CheckExtent(const core::VoxelMap& map, const std::filesystem::path& path) {
         << (hi.z() + 1) * s << " m), but OctoMap's 16-bit keys hold only voxels "
         << -kOctomapKeyLimit << ".." << kOctomapKeyLimit - 1 << " per axis (+-"
         << kOctomapKeyLimit * s << " m at " << s << " m voxels); crop or tile the map first";
-    throw std::runtime_error(msg.str());
+    throw RefusedError(msg.str());
 }
 
 octomap::OcTreeKey KeyOf(const openvdb::Coord& ijk) {
@@ -83,7 +84,7 @@ void WriteBinaryTree(const core::VoxelMap& map, const std::filesystem::path& pat
     octomap::OcTree tree(map.voxel_size);
     CopyOccupancy(map, tree, [](octomap::OcTreeNode*, const openvdb::Coord&, float) {});
     WriteFileAtomically(path, [&](std::ostream& os) {
-        if (!tree.writeBinary(os)) throw std::runtime_error("OctoMap could not serialise the tree");
+        if (!tree.writeBinary(os)) throw IoError("OctoMap could not serialise the tree");
     });
 }
 
@@ -98,7 +99,7 @@ void WriteColorTree(const core::VoxelMap& map, const std::filesystem::path& path
                   });
     // AbstractOcTree::write keeps every leaf: no pruning, so no colour averaging.
     WriteFileAtomically(path, [&](std::ostream& os) {
-        if (!tree.write(os)) throw std::runtime_error("OctoMap could not serialise the tree");
+        if (!tree.write(os)) throw IoError("OctoMap could not serialise the tree");
     });
 }
 
@@ -108,7 +109,7 @@ void WriteOctomap(const core::VoxelMap& map, const std::filesystem::path& path) 
     detail::RequireGrids(map, path);
     const std::string ext = LowerExtension(path);
     if (ext != ".bt" && ext != ".ot") {
-        throw std::invalid_argument("cannot write '" + path.string() +
+        throw InvalidArgumentError("cannot write '" + path.string() +
                                     "' as OctoMap: the extension must be .bt or .ot");
     }
     CheckExtent(map, path);

@@ -1,6 +1,6 @@
 #include "PcdHeader.hpp"
 
-#include <stdexcept>
+#include <vector>
 
 #include "TextParsing.hpp"
 
@@ -35,14 +35,29 @@ int PcdHeader::Find(std::string_view name) const {
     return -1;
 }
 
-PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
-    PcdHeader header;
-    std::vector<std::string_view> sizes, types, counts, values;
+namespace {
+
+// The header's lines as written, before they are checked against each other.
+struct RawPcdHeader {
+    std::vector<std::string_view> fields, sizes, types, counts;
     bool has_points = false, has_width = false, has_data = false;
     unsigned long long width = 0, height = 1, points = 0;
-    LineReader lines(text);
+    PcdEncoding encoding = PcdEncoding::kAscii;
+};
+
+PcdEncoding EncodingOf(std::string_view kind, const std::string& file, size_t line) {
+    if (kind == "ascii") return PcdEncoding::kAscii;
+    if (kind == "binary") return PcdEncoding::kBinary;
+    if (kind == "binary_compressed") return PcdEncoding::kBinaryCompressed;
+    FailHeader(file, line, "unknown DATA encoding '" + std::string(kind) + "'");
+}
+
+// Reads key lines up to and including DATA; `lines` is left at the first data byte.
+RawPcdHeader ReadKeys(LineReader& lines, const std::string& file) {
+    RawPcdHeader raw;
+    std::vector<std::string_view> values;
     std::string_view line;
-    while (!has_data && lines.Next(line)) {
+    while (!raw.has_data && lines.Next(line)) {
         const size_t n = lines.line_number();
         SplitFields(StripComment(line), values);
         if (values.empty()) continue;
@@ -58,67 +73,60 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
         };
         if (key == "VERSION" || key == "VIEWPOINT") continue;
         if (key == "FIELDS") {
-            header.fields.clear();
-            for (std::string_view v : values) {
-                PcdField field;
-                field.name = std::string(v);
-                header.fields.push_back(field);
-            }
+            raw.fields = values;
         } else if (key == "SIZE") {
-            sizes = values;
+            raw.sizes = values;
         } else if (key == "TYPE") {
-            types = values;
+            raw.types = values;
         } else if (key == "COUNT") {
-            counts = values;
+            raw.counts = values;
         } else if (key == "WIDTH") {
-            width = number(kMaxDimension);
-            has_width = true;
+            raw.width = number(kMaxDimension);
+            raw.has_width = true;
         } else if (key == "HEIGHT") {
-            height = number(kMaxDimension);
+            raw.height = number(kMaxDimension);
         } else if (key == "POINTS") {
-            points = number(kMaxDimension * kMaxDimension);  // 2^62
-            has_points = true;
+            raw.points = number(kMaxDimension * kMaxDimension);  // 2^62
+            raw.has_points = true;
         } else if (key == "DATA") {
-            const std::string_view kind = values.empty() ? std::string_view() : values[0];
-            if (kind == "ascii") {
-                header.encoding = PcdEncoding::kAscii;
-            } else if (kind == "binary") {
-                header.encoding = PcdEncoding::kBinary;
-            } else if (kind == "binary_compressed") {
-                header.encoding = PcdEncoding::kBinaryCompressed;
-            } else {
-                FailHeader(file, n, "unknown DATA encoding '" + std::string(kind) + "'");
-            }
-            has_data = true;
+            raw.encoding = EncodingOf(values.empty() ? std::string_view() : values[0], file, n);
+            raw.has_data = true;
         } else {
             FailHeader(file, n,
                        "unknown key '" + std::string(key.substr(0, 32)) + "' (not a PCD file?)");
         }
     }
-    const size_t n = lines.line_number();
-    if (!has_data) FailHeader(file, n, "no DATA line: not a PCD file, or the header is truncated");
-    const size_t num_fields = header.fields.size();
+    return raw;
+}
+
+// One PcdField per FIELDS entry, with its type, count and place in a binary record.
+void LayOutFields(const RawPcdHeader& raw, PcdHeader& header, const std::string& file, size_t n) {
+    const size_t num_fields = raw.fields.size();
     if (num_fields == 0) FailHeader(file, n, "no FIELDS");
-    if (sizes.size() != num_fields || types.size() != num_fields ||
-        (!counts.empty() && counts.size() != num_fields)) {
+    if (raw.sizes.size() != num_fields || raw.types.size() != num_fields ||
+        (!raw.counts.empty() && raw.counts.size() != num_fields)) {
         FailHeader(file, n,
-             std::to_string(num_fields) + " FIELDS but " + std::to_string(sizes.size()) +
-                 " SIZE, " + std::to_string(types.size()) + " TYPE and " +
-                 std::to_string(counts.size()) + " COUNT entries");
+                   std::to_string(num_fields) + " FIELDS but " + std::to_string(raw.sizes.size()) +
+                       " SIZE, " + std::to_string(raw.types.size()) + " TYPE and " +
+                       std::to_string(raw.counts.size()) + " COUNT entries");
     }
+    header.fields.assign(num_fields, PcdField{});
     for (size_t i = 0; i < num_fields; ++i) {
         PcdField& field = header.fields[i];
+        field.name = std::string(raw.fields[i]);
         unsigned long long size = 0, count = 1;
-        bool ok = ParseUint(sizes[i], size);
-        if (ok) field.type = ToScalarType(types[i], size, ok);
+        bool ok = ParseUint(raw.sizes[i], size);
+        if (ok) field.type = ToScalarType(raw.types[i], size, ok);
         if (!ok) {
             FailHeader(file, n,
-                 "field '" + field.name + "' has unsupported TYPE " + std::string(types[i]) +
-                     " with SIZE " + std::string(sizes[i]));
+                       "field '" + field.name + "' has unsupported TYPE " +
+                           std::string(raw.types[i]) + " with SIZE " + std::string(raw.sizes[i]));
         }
-        if (!counts.empty() && (!ParseUint(counts[i], count) || count == 0 || count > kMaxCount)) {
+        if (!raw.counts.empty() &&
+            (!ParseUint(raw.counts[i], count) || count == 0 || count > kMaxCount)) {
             FailHeader(file, n,
-                       "field '" + field.name + "' has invalid COUNT " + std::string(counts[i]));
+                       "field '" + field.name + "' has invalid COUNT " +
+                           std::string(raw.counts[i]));
         }
         field.size = static_cast<size_t>(size);
         field.count = static_cast<size_t>(count);
@@ -127,18 +135,32 @@ PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
         header.record_size += field.size * field.count;
         header.values_per_point += field.count;
     }
-    if (!has_width) FailHeader(file, n, "no WIDTH");
-    if (!has_points) points = width * height;
-    if (points != width * height) {
+}
+
+}  // namespace
+
+PcdHeader ParsePcdHeader(std::string_view text, const std::string& file) {
+    LineReader lines(text);
+    const RawPcdHeader raw = ReadKeys(lines, file);
+    const size_t n = lines.line_number();
+    if (!raw.has_data) {
+        FailHeader(file, n, "no DATA line: not a PCD file, or the header is truncated");
+    }
+    PcdHeader header;
+    header.encoding = raw.encoding;
+    LayOutFields(raw, header, file, n);
+    if (!raw.has_width) FailHeader(file, n, "no WIDTH");
+    const unsigned long long points = raw.has_points ? raw.points : raw.width * raw.height;
+    if (points != raw.width * raw.height) {
         FailHeader(file, n,
-             "POINTS " + std::to_string(points) + " disagrees with WIDTH * HEIGHT = " +
-                 std::to_string(width) + " * " + std::to_string(height));
+                   "POINTS " + std::to_string(points) + " disagrees with WIDTH * HEIGHT = " +
+                       std::to_string(raw.width) + " * " + std::to_string(raw.height));
     }
     for (const char* axis : {"x", "y", "z"}) {
         if (header.Find(axis) < 0) FailHeader(file, n, std::string("no '") + axis + "' field");
     }
-    header.width = static_cast<size_t>(width);
-    header.height = static_cast<size_t>(height);
+    header.width = static_cast<size_t>(raw.width);
+    header.height = static_cast<size_t>(raw.height);
     header.points = static_cast<size_t>(points);
     header.data_offset = lines.position();
     header.header_lines = n;

@@ -38,7 +38,7 @@ struct PcdHeader {
     [[nodiscard]] int Find(std::string_view name) const;
 };
 
-/// @brief Parses and checks the header; throws std::runtime_error naming `file` for unknown
+/// @brief Parses and checks the header; throws FormatError naming `file` for unknown
 /// keys, unsupported TYPE/SIZE pairs, lists of different lengths, POINTS != WIDTH * HEIGHT and
 /// a missing x, y or z field.
 [[nodiscard]] PcdHeader ParsePcdHeader(std::string_view text, const std::string& file);

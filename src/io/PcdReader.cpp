@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "BinaryCursor.hpp"
+#include "strata/core/Error.hpp"
 #include "PcdHeader.hpp"
 #include "ScanBuilder.hpp"
 #include "TextParsing.hpp"
@@ -56,14 +57,14 @@ void ReadAsciiPoints(std::string_view text, const PcdHeader& h, const PcdColumns
         if (values.empty()) continue;
         const size_t line_number = h.header_lines + lines.line_number();
         if (values.size() != h.values_per_point) {
-            throw std::runtime_error(file + ": line " + std::to_string(line_number) + " has " +
+            throw FormatError(file + ": line " + std::to_string(line_number) + " has " +
                                      std::to_string(values.size()) + " values, expected " +
                                      std::to_string(h.values_per_point));
         }
         // Every value must parse, used or not: a bad token anywhere means a corrupt file.
         for (size_t k = 0; k < values.size(); ++k) {
             if (!detail::ParseDouble(values[k], row[k])) {
-                throw std::runtime_error(file + ": line " + std::to_string(line_number) +
+                throw FormatError(file + ": line " + std::to_string(line_number) +
                                          ": cannot parse '" + std::string(values[k].substr(0, 40)) +
                                          "'");
             }
@@ -74,7 +75,7 @@ void ReadAsciiPoints(std::string_view text, const PcdHeader& h, const PcdColumns
         ++read;
     }
     if (read < h.points) {
-        throw std::runtime_error(file + ": truncated: " + std::to_string(read) + " of " +
+        throw FormatError(file + ": truncated: " + std::to_string(read) + " of " +
                                  std::to_string(h.points) + " points in the ascii data");
     }
 }

@@ -1,4 +1,5 @@
 #include "PlyHeader.hpp"
+#include "strata/core/Error.hpp"
 
 #include <stdexcept>
 
@@ -57,7 +58,7 @@ PlyHeader ParsePlyHeader(std::string_view text, const std::string& file) {
     LineReader lines(text);
     std::string_view line;
     if (!lines.Next(line) || line != "ply") {
-        throw std::runtime_error(file + ": not a PLY file (the first line is not 'ply')");
+        throw FormatError(file + ": not a PLY file (the first line is not 'ply')");
     }
     std::vector<std::string_view> words;
     bool has_format = false;
@@ -108,7 +109,7 @@ PlyHeader ParsePlyHeader(std::string_view text, const std::string& file) {
             FailHeader(file, n, "unexpected line '" + std::string(line.substr(0, 80)) + "'");
         }
     }
-    throw std::runtime_error(file + ": no end_header: the PLY header is truncated");
+    throw FormatError(file + ": no end_header: the PLY header is truncated");
 }
 
 }  // namespace strata::io::detail

@@ -41,7 +41,7 @@ struct PlyHeader {
     size_t header_lines = 0;  ///< lines up to and including end_header
 };
 
-/// @brief Parses the header; throws std::runtime_error naming `file` for a missing `ply` magic,
+/// @brief Parses the header; throws FormatError naming `file` for a missing `ply` magic,
 /// an unknown format or type, a property outside an element, or no end_header.
 [[nodiscard]] PlyHeader ParsePlyHeader(std::string_view text, const std::string& file);
 

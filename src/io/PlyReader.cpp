@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "BinaryCursor.hpp"
+#include "strata/core/Error.hpp"
 #include "PlyHeader.hpp"
 #include "ScanBuilder.hpp"
 #include "TextParsing.hpp"
@@ -119,7 +120,7 @@ core::Scan ReadVertices(PlyValues& values, const PlyElement& element,
     const int intensity = element.Find({"intensity", "scalar_intensity", "reflectance"});
     const int label = element.Find({"label", "class", "classification"});
     if (x < 0 || y < 0 || z < 0) {
-        throw std::runtime_error(path.string() + ": the vertex element has no x, y and z");
+        throw FormatError(path.string() + ": the vertex element has no x, y and z");
     }
     std::vector<int> role(element.properties.size(), -1);
     const int roles[5] = {x, y, z, intensity, label};
@@ -170,7 +171,7 @@ core::Scan ReadPly(const std::filesystem::path& path, const ReadOptions& options
             values.SkipElement(element);
         }
     }
-    if (!has_vertices) throw std::runtime_error(file + ": no vertex element");
+    if (!has_vertices) throw FormatError(file + ": no vertex element");
     return scan;
 }
 

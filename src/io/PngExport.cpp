@@ -1,4 +1,5 @@
 #include "strata/io/PngExport.hpp"
+#include "strata/core/Error.hpp"
 
 #include <openvdb/tools/ValueTransformer.h>
 
@@ -105,7 +106,7 @@ core::Rgb Shade(core::Rgb c, double factor) {
 
 TopDownImage RenderTopDown(const core::VoxelMap& map, const TopDownOptions& options) {
     if (options.pixels_per_voxel < 1 || options.max_size_px < 1) {
-        throw std::invalid_argument(
+        throw InvalidArgumentError(
             "top-down picture: pixels_per_voxel and max_size_px must be >= 1");
     }
     detail::RequireGrids(map, std::string("a top-down picture"));

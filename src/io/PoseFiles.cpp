@@ -1,4 +1,5 @@
 #include "strata/io/PoseFiles.hpp"
+#include "strata/core/Error.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -16,7 +17,7 @@ namespace {
 constexpr double kRotationTolerance = 1e-3;
 
 [[noreturn]] void Fail(const std::string& file, size_t line, const std::string& message) {
-    throw std::runtime_error(file + ": line " + std::to_string(line) + ": " + message);
+    throw FormatError(file + ": line " + std::to_string(line) + ": " + message);
 }
 
 // Parses every field of a data line as a finite number.
@@ -122,7 +123,7 @@ Eigen::Isometry3d ReadKittiCalibTr(const std::filesystem::path& calib_txt) {
                         Tr = PoseFrom3x4(ParseNumbers(numbers, file, line), 0, file, line);
                         found = true;
                     });
-    if (!found) throw std::runtime_error(file + ": no `Tr:` line (velodyne -> camera transform)");
+    if (!found) throw FormatError(file + ": no `Tr:` line (velodyne -> camera transform)");
     return Tr;
 }
 
@@ -160,11 +161,11 @@ namespace {
 template <typename Body>
 void WriteText(const std::filesystem::path& path, Body body) {
     std::ofstream out(path);
-    if (!out) throw std::runtime_error(path.string() + ": cannot open file for writing");
+    if (!out) throw IoError(path.string() + ": cannot open file for writing");
     out.precision(std::numeric_limits<double>::max_digits10);
     body(out);
     out.close();
-    if (!out) throw std::runtime_error(path.string() + ": write error");
+    if (!out) throw IoError(path.string() + ": write error");
 }
 
 }  // namespace

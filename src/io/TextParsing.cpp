@@ -2,10 +2,11 @@
 
 #include "strata/core/Error.hpp"
 
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <fstream>
 #include <sstream>
-#include <stdexcept>
 #include <system_error>
 
 namespace strata::io::detail {
@@ -14,16 +15,32 @@ void FailHeader(const std::string& file, size_t line, const std::string& message
     throw FormatError(file + ": header line " + std::to_string(line) + ": " + message);
 }
 
-std::string ReadTextFile(const std::filesystem::path& path) {
+void RequireFile(const std::filesystem::path& path) {
     std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
-        throw std::runtime_error(path.string() + ": is a directory, expected a file");
+    const auto status = std::filesystem::status(path, ec);
+    if (status.type() == std::filesystem::file_type::not_found) {
+        throw NotFoundError(path.string() + ": no such file");
     }
+    if (status.type() == std::filesystem::file_type::directory) {
+        throw InvalidArgumentError(path.string() + ": is a directory, expected a file");
+    }
+}
+
+void FailOpen(const std::filesystem::path& path) {
+    const int error = errno;  // before anything else can overwrite it
+    RequireFile(path);
+    throw IoError(path.string() + ": cannot open file for reading" +
+                  (error != 0 ? std::string(": ") + std::strerror(error) : std::string()));
+}
+
+std::string ReadTextFile(const std::filesystem::path& path) {
+    RequireFile(path);
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path.string() + ": cannot open file for reading");
+    if (!in) FailOpen(path);
     std::ostringstream buffer;
     buffer << in.rdbuf();
-    if (in.bad()) throw std::runtime_error(path.string() + ": read error");
+    if (in.bad()) throw IoError(path.string() + ": read error");
     return buffer.str();
 }
 

@@ -11,7 +11,16 @@
 
 namespace strata::io::detail {
 
-/// @brief Reads a whole text file; throws std::runtime_error naming it on failure.
+/// @brief Throws NotFoundError when `path` does not exist, InvalidArgumentError when it is a
+/// directory; returns otherwise (the file may still be unreadable).
+void RequireFile(const std::filesystem::path& path);
+
+/// @brief Throws the error for a file that exists but would not open for reading: IoError with
+/// the system's reason (no permission, ...), or what RequireFile throws.
+[[noreturn]] void FailOpen(const std::filesystem::path& path);
+
+/// @brief Reads a whole text file; throws NotFoundError, InvalidArgumentError or IoError naming
+/// it (see RequireFile, FailOpen).
 [[nodiscard]] std::string ReadTextFile(const std::filesystem::path& path);
 
 /// @brief Throws FormatError "<file>: header line <line>: <message>" (PCD and PLY headers).

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ScanBuilder.hpp"
+#include "strata/core/Error.hpp"
 #include "TextParsing.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
@@ -47,7 +48,7 @@ constexpr uint64_t kMinBzip2Limit = uint64_t{64} << 20;
 std::string ReadBzip2File(const std::filesystem::path& path) {
     const std::string file = path.string();
     std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
-    if (!f) throw std::runtime_error(file + ": cannot open file for reading");
+    if (!f) detail::FailOpen(path);
     std::error_code ec;
     const uint64_t compressed = std::filesystem::file_size(path, ec);
     const uint64_t limit = std::max(kMinBzip2Limit, kMaxBzip2Ratio * (ec ? 0 : compressed));
@@ -60,14 +61,14 @@ std::string ReadBzip2File(const std::filesystem::path& path) {
             BZ2_bzReadOpen(&error, f.get(), 0, 0, unused.data(), static_cast<int>(unused.size()));
         if (error != BZ_OK) {
             BZ2_bzReadClose(&error, bz);
-            throw std::runtime_error(file + ": cannot start bzip2 decompression");
+            throw IoError(file + ": cannot start bzip2 decompression");
         }
         while (error == BZ_OK) {
             const int n = BZ2_bzRead(&error, bz, chunk.data(), static_cast<int>(chunk.size()));
             if (error == BZ_OK || error == BZ_STREAM_END) text.append(chunk.data(), n);
             if (text.size() > limit) {
                 BZ2_bzReadClose(&error, bz);
-                throw std::runtime_error(file + ": decompresses to more than " +
+                throw FormatError(file + ": decompresses to more than " +
                                          std::to_string(limit) + " bytes (" +
                                          std::to_string(kMaxBzip2Ratio) +
                                          " times the file, at least 64 MiB): not point-cloud text");
@@ -76,7 +77,7 @@ std::string ReadBzip2File(const std::filesystem::path& path) {
         if (error != BZ_STREAM_END) {
             int ignored = BZ_OK;
             BZ2_bzReadClose(&ignored, bz);
-            throw std::runtime_error(file + ": " + Bzip2Error(error) + " after " +
+            throw FormatError(file + ": " + Bzip2Error(error) + " after " +
                                      std::to_string(text.size()) + " decompressed bytes");
         }
         void* rest = nullptr;
@@ -116,7 +117,7 @@ core::Scan ReadText(const std::filesystem::path& path, const ReadOptions& option
         detail::SplitFields(detail::StripComment(line), fields);
         if (fields.empty()) continue;
         auto fail = [&](const std::string& what) {
-            throw std::runtime_error(file + ": line " + std::to_string(lines.line_number()) + ": " +
+            throw FormatError(file + ": line " + std::to_string(lines.line_number()) + ": " +
                                      what);
         };
         if (columns == 0) {

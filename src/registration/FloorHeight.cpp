@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <stdexcept>
 #include <unordered_map>
 
+#include "strata/core/Error.hpp"
 #include "strata/registration/Surface.hpp"
 
 namespace strata::registration {
@@ -130,7 +130,7 @@ Fit FitAt(const ColumnIndex& index, const std::vector<Eigen::Vector3d>& floor, d
 
 void FloorHeightConfig::Validate() const {
     auto require = [](bool ok, const char* what) {
-        if (!ok) throw std::invalid_argument(std::string("floor height config: ") + what);
+        if (!ok) throw InvalidArgumentError(std::string("floor height config: ") + what);
     };
     require(std::isfinite(search_m) && search_m > 0.0, "search_m must be positive");
     require(std::isfinite(cell_m) && cell_m > 0.0, "cell_m must be positive");

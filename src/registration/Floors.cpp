@@ -2,7 +2,8 @@
 
 #include <cmath>
 #include <limits>
-#include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::registration {
 
@@ -39,7 +40,7 @@ double TurnDeg(const RegistrationResult& r) { return std::abs(YawDeg(r.T_map_sou
 
 void FloorSlice::Validate() const {
     if (!std::isfinite(l1_m) || !std::isfinite(l2_m) || !(l1_m < l2_m)) {
-        throw std::invalid_argument("floor slice: need finite l1 < l2");
+        throw InvalidArgumentError("floor slice: need finite l1 < l2");
     }
 }
 
@@ -53,13 +54,23 @@ RegistrationConfig FloorStackConfig::DefaultRegistration() {
     RegistrationConfig config;
     config.planar = true;
     config.min_overlap = 0.3;
+    // 24 yaw starts each: the finest level keeps the coarse levels' cap.
+    config.max_finest_source_points = config.max_source_points;
+    return config;
+}
+
+RegistrationConfig LocalizationRegistration() {
+    RegistrationConfig config;
+    config.surface.level_cells_m = {1.0, 0.5, 0.25};
+    config.max_source_points = 1500;
+    config.max_finest_source_points = 1500;
     return config;
 }
 
 void FloorStackConfig::Validate() const {
-    if (!std::isfinite(z_bias_m)) throw std::invalid_argument("floor stack: z_bias_m not finite");
+    if (!std::isfinite(z_bias_m)) throw InvalidArgumentError("floor stack: z_bias_m not finite");
     if (!(yaw_step_deg > 0.0 && yaw_step_deg <= 360.0)) {
-        throw std::invalid_argument("floor stack: yaw_step_deg must be in (0, 360]");
+        throw InvalidArgumentError("floor stack: yaw_step_deg must be in (0, 360]");
     }
     slice.Validate();
     registration.Validate();
@@ -78,13 +89,13 @@ FloorStackResult StackFloor(const std::vector<Eigen::Vector3d>& reference_map,
         Band(reference_map, reference_floor_z_m, config.slice);
     const std::vector<Eigen::Vector3d> source_band = Band(floor_points, 0.0, config.slice);
     if (target_band.empty() || source_band.empty()) {
-        throw std::invalid_argument("StackFloor: no points in the band " +
-                                    std::to_string(config.slice.l1_m) + " < z - z_floor < " +
-                                    std::to_string(config.slice.l2_m) + " of " +
-                                    (target_band.empty() ? "the reference" : "the floor"));
+        throw InvalidArgumentError("StackFloor: no points in the band " +
+                                   std::to_string(config.slice.l1_m) + " < z - z_floor < " +
+                                   std::to_string(config.slice.l2_m) + " of " +
+                                   (target_band.empty() ? "the reference" : "the floor"));
     }
     const Surface target = Surface::FromPoints(target_band, reg.surface);
-    if (target.empty()) throw std::invalid_argument("StackFloor: the reference has no walls");
+    if (target.empty()) throw InvalidArgumentError("StackFloor: the reference has no walls");
 
     // Step 2: planar ICP from the guess, or from every yaw start with the centroids aligned.
     std::vector<Eigen::Isometry3d> starts;

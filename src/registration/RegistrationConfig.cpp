@@ -1,15 +1,16 @@
 #include "strata/registration/RegistrationConfig.hpp"
 
 #include <cmath>
-#include <stdexcept>
 #include <string>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::registration {
 
 namespace {
 
 void Require(bool ok, const std::string& what) {
-    if (!ok) throw std::invalid_argument("registration config: " + what);
+    if (!ok) throw InvalidArgumentError("registration config: " + what);
 }
 
 }  // namespace
@@ -36,6 +37,7 @@ void RegistrationConfig::Validate() const {
     Require(max_source_range_m == 0.0 || max_source_range_m > min_source_range_m,
             "max_source_range_m must be 0 or above min_source_range_m");
     Require(max_source_points >= 100, "max_source_points must be >= 100");
+    Require(max_finest_source_points >= 100, "max_finest_source_points must be >= 100");
     Require(max_iterations_per_level >= 1, "max_iterations_per_level must be >= 1");
     Require(solver_iterations >= 1, "solver_iterations must be >= 1");
     Require(robust_scale_ratio > 0.0, "robust_scale_ratio must be > 0");

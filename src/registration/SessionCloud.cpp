@@ -1,14 +1,15 @@
 #include "strata/registration/SessionCloud.hpp"
 
 #include <cmath>
-#include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::registration {
 
 void SessionCloudConfig::Validate() const {
-    if (!(cell_m > 0.0)) throw std::invalid_argument("session cloud: cell_m must be > 0");
+    if (!(cell_m > 0.0)) throw InvalidArgumentError("session cloud: cell_m must be > 0");
     if (!(min_range_m >= 0.0) || !(max_range_m > min_range_m)) {
-        throw std::invalid_argument("session cloud: need 0 <= min_range_m < max_range_m");
+        throw InvalidArgumentError("session cloud: need 0 <= min_range_m < max_range_m");
     }
 }
 

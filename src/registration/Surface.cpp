@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "strata/core/Error.hpp"
+
 namespace strata::registration {
 
 namespace {
@@ -167,7 +169,7 @@ std::vector<Eigen::Vector3d> MaskedPoints(const core::VoxelMap& map, const openv
 
 std::vector<Eigen::Vector3d> Downsample(const std::vector<Eigen::Vector3d>& points, double cell_m,
                                         double min_range_m, double max_range_m) {
-    if (!(cell_m > 0.0)) throw std::invalid_argument("Downsample: cell_m must be > 0");
+    if (!(cell_m > 0.0)) throw InvalidArgumentError("Downsample: cell_m must be > 0");
     const double inv_cell = 1.0 / cell_m;
     const double min_range2 = min_range_m * min_range_m;
     const double max_range2 = max_range_m * max_range_m;

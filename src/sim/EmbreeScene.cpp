@@ -1,4 +1,5 @@
 #include "EmbreeScene.hpp"
+#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -11,7 +12,7 @@ namespace strata::sim {
 namespace {
 
 [[noreturn]] void ThrowEmbree(RTCError code, const std::string& what) {
-    throw std::runtime_error("Embree: " + what + " (error " + std::to_string(int(code)) + ")");
+    throw Error("Embree: " + what + " (error " + std::to_string(int(code)) + ")");
 }
 
 // Closest point of triangle abc to p, by the Voronoi region of p (vertex, edge or face).

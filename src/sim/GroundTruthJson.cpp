@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "strata/sim/GroundTruth.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::sim {
 namespace {
@@ -114,7 +115,7 @@ void WriteGroundTruth(const std::filesystem::path& path, const GroundTruth& trut
     std::ofstream out(path);
     out << j.dump(1) << "\n";
     out.close();
-    if (!out) throw std::runtime_error("cannot write " + path.string());
+    if (!out) throw IoError("cannot write " + path.string());
 }
 
 }  // namespace strata::sim

@@ -1,3 +1,4 @@
+#include "strata/core/Error.hpp"
 #pragma once
 
 // Strict reading of scene JSON (private): a missing key takes its default, an unknown key or a
@@ -61,14 +62,14 @@ public:
         }
         return items;
     }
-    /// Throws std::invalid_argument for keys that were never asked for (typos, unknown keys).
+    /// Throws FormatError for keys that were never asked for (typos, unknown keys).
     void Finish() const {
         for (const auto& item : j_.items()) {
             if (used_.count(item.key()) == 0) Fail("unknown key '" + item.key() + "'");
         }
     }
     [[noreturn]] void Fail(const std::string& what) const {
-        throw std::invalid_argument(source_ + ": " + (path_.empty() ? "" : path_ + ": ") + what);
+        throw FormatError(source_ + ": " + (path_.empty() ? "" : path_ + ": ") + what);
     }
     [[nodiscard]] const std::string& source() const { return source_; }
     [[nodiscard]] const std::string& path() const { return path_; }

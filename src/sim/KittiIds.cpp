@@ -1,4 +1,5 @@
 #include "strata/sim/KittiIds.hpp"
+#include "strata/core/Error.hpp"
 
 #include <array>
 #include <cctype>
@@ -51,7 +52,7 @@ uint16_t IdFromName(const std::string& name) {
             if (id == e.id) return e.id;
         }
     }
-    throw std::invalid_argument("unknown SemanticKITTI class '" + name + "'");
+    throw InvalidArgumentError("unknown SemanticKITTI class '" + name + "'");
 }
 
 const char* Name(uint16_t id) {

@@ -26,7 +26,7 @@ namespace strata::sim::detail {
 [[nodiscard]] bool SlabCovers(const SlabSpec& slab, double x, double y);
 
 /// Default size (length, width, height) and class of a vehicle type; throws
-/// std::invalid_argument for an unknown type.
+/// InvalidArgumentError for an unknown type.
 struct VehicleType {
     Eigen::Vector3d size;
     uint16_t label;

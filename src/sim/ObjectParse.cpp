@@ -53,7 +53,7 @@ uint16_t ReadClass(JsonReader& r, const std::string& key, const char* fallback) 
     const std::string name = r.Get<std::string>(key, fallback);
     try {
         return kitti::IdFromName(name);
-    } catch (const std::invalid_argument& e) {
+    } catch (const InvalidArgumentError& e) {
         r.Fail("'" + key + "': " + e.what());
     }
 }
@@ -70,7 +70,7 @@ ObjectSpec ParseObject(JsonReader& r, const std::string& kind, SceneAssembler& a
         VehicleType type;
         try {
             type = VehicleTypeOf(v.type);
-        } catch (const std::invalid_argument& e) {
+        } catch (const InvalidArgumentError& e) {
             r.Fail(e.what());
         }
         ReadCommon(r, o, kitti::Name(type.label), 0.5F);

@@ -1,6 +1,7 @@
 #include <stdexcept>
 
 #include "strata/io/Image.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/ScenePicture.hpp"
 
 namespace strata::sim {
@@ -8,7 +9,7 @@ namespace strata::sim {
 void WritePicturePng(const std::filesystem::path& path, const Picture& picture) {
     if (picture.width <= 0 || picture.height <= 0 ||
         picture.rgb.size() != size_t(picture.width) * size_t(picture.height) * 3) {
-        throw std::invalid_argument("cannot write an empty or malformed picture to " +
+        throw InvalidArgumentError("cannot write an empty or malformed picture to " +
                                     path.string());
     }
     io::RgbImage image(picture.width, picture.height);

@@ -1,4 +1,5 @@
 #include "strata/sim/ScenePicture.hpp"
+#include "strata/core/Error.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -77,7 +78,7 @@ std::optional<RayHit> SolidAround(const Scene& scene, const Simulator& simulator
 
 void PictureConfig::Validate() const {
     if (!(pixel_m > 0.0) || !(margin_m >= 0.0) || max_size_px < 16) {
-        throw std::invalid_argument("picture: pixel_m > 0, margin_m >= 0, max_size_px >= 16");
+        throw InvalidArgumentError("picture: pixel_m > 0, margin_m >= 0, max_size_px >= 16");
     }
 }
 

@@ -1,4 +1,5 @@
 #include "strata/sim/SceneSpec.hpp"
+#include "strata/core/Error.hpp"
 
 #include <fstream>
 #include <limits>
@@ -23,7 +24,7 @@ ObjectSpec& SceneAssembler::Add(ObjectSpec object, const std::string& prefix) {
 }
 
 int SceneAssembler::NewId() {
-    if (next_id_ > 65535) throw std::invalid_argument(spec_.source + ": more than 65535 objects");
+    if (next_id_ > 65535) throw FormatError(spec_.source + ": more than 65535 objects");
     return next_id_++;
 }
 
@@ -41,21 +42,27 @@ double SceneAssembler::GroundZ(double x, double y, double fallback) const {
 
 namespace {
 
+[[noreturn]] void FailRead(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw NotFoundError("no scene file " + path.string());
+    throw IoError("cannot read scene file " + path.string());
+}
+
 using nlohmann::json;
 
 // "include": "base.json" merges a base file under this one (keys here replace the base's).
 json ResolveIncludes(json j, const std::filesystem::path& dir, const std::string& source,
                      int depth) {
     if (!j.is_object() || !j.contains("include")) return j;
-    if (depth > 4) throw std::invalid_argument(source + ": 'include' nested too deeply");
+    if (depth > 4) throw FormatError(source + ": 'include' nested too deeply");
     const std::filesystem::path base_path = dir / j.at("include").get<std::string>();
     std::ifstream in(base_path);
-    if (!in) throw std::runtime_error("cannot read scene file " + base_path.string());
+    if (!in) FailRead(base_path);
     json base;
     try {
         base = json::parse(in);
     } catch (const json::parse_error& e) {
-        throw std::runtime_error("cannot parse scene file " + base_path.string() + ": " + e.what());
+        throw FormatError("cannot parse scene file " + base_path.string() + ": " + e.what());
     }
     base = ResolveIncludes(std::move(base), base_path.parent_path(), base_path.string(), depth + 1);
     j.erase("include");
@@ -123,16 +130,16 @@ void SceneSpec::Validate() const {
     std::set<std::string> names;
     for (const ObjectSpec& o : objects) {
         if (!ids.insert(o.id).second) {
-            throw std::invalid_argument(source + ": duplicate object id " + std::to_string(o.id));
+            throw FormatError(source + ": duplicate object id " + std::to_string(o.id));
         }
         if (!names.insert(o.name).second) {
-            throw std::invalid_argument(source + ": duplicate object name '" + o.name + "'");
+            throw FormatError(source + ": duplicate object name '" + o.name + "'");
         }
     }
-    if (sessions.empty()) throw std::invalid_argument(source + ": no sessions");
+    if (sessions.empty()) throw FormatError(source + ": no sessions");
     for (size_t s = 0; s < sessions.size(); ++s) {
         if (sessions[s].trajectory.waypoints.empty()) {
-            throw std::invalid_argument(source + ": session '" + sessions[s].name +
+            throw FormatError(source + ": session '" + sessions[s].name +
                                         "' has no trajectory waypoints");
         }
         (void)ObjectsOfSession(*this, s);  // throws on an edit of an unknown object
@@ -143,7 +150,7 @@ size_t SceneSpec::IndexOf(const std::string& object_name) const {
     for (size_t i = 0; i < objects.size(); ++i) {
         if (objects[i].name == object_name) return i;
     }
-    throw std::invalid_argument(source + ": no object named '" + object_name + "'");
+    throw FormatError(source + ": no object named '" + object_name + "'");
 }
 
 SceneSpec ParseSceneSpec(const std::string& json_text, const std::string& source) {
@@ -151,7 +158,7 @@ SceneSpec ParseSceneSpec(const std::string& json_text, const std::string& source
     try {
         root = json::parse(json_text);
     } catch (const json::parse_error& e) {
-        throw std::runtime_error("cannot parse scene file " + source + ": " + e.what());
+        throw FormatError("cannot parse scene file " + source + ": " + e.what());
     }
     const std::filesystem::path dir = std::filesystem::path(source).parent_path();
     return ParseJson(ResolveIncludes(std::move(root), dir, source, 0), source);
@@ -159,7 +166,7 @@ SceneSpec ParseSceneSpec(const std::string& json_text, const std::string& source
 
 SceneSpec LoadSceneSpec(const std::filesystem::path& path) {
     std::ifstream in(path);
-    if (!in) throw std::runtime_error("cannot read scene file " + path.string());
+    if (!in) FailRead(path);
     std::ostringstream text;
     text << in.rdbuf();
     return ParseSceneSpec(text.str(), path.string());

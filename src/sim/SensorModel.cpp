@@ -1,4 +1,5 @@
 #include "strata/sim/SensorModel.hpp"
+#include "strata/core/Error.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -62,7 +63,7 @@ SensorModel SensorModel::FromName(const std::string& name) {
     if (name == "vlp16") return Vlp16();
     if (name == "os1-64") return Os1(64);
     if (name == "os1-128") return Os1(128);
-    throw std::invalid_argument("unknown sensor '" + name + "' (hdl64, vlp16, os1-64, os1-128)");
+    throw InvalidArgumentError("unknown sensor '" + name + "' (hdl64, vlp16, os1-64, os1-128)");
 }
 
 std::vector<std::string> SensorModel::Names() { return {"hdl64", "vlp16", "os1-64", "os1-128"}; }
@@ -75,7 +76,7 @@ double SensorModel::ColumnTimeS(int column) const { return (column + 0.5) / (col
 
 void SensorModel::Validate() const {
     const auto fail = [this](const std::string& what) {
-        throw std::invalid_argument("sensor '" + name + "': " + what);
+        throw InvalidArgumentError("sensor '" + name + "': " + what);
     };
     if (elevation_deg.empty()) fail("empty beam table");
     for (double e : elevation_deg) {

@@ -1,4 +1,5 @@
 #include "strata/sim/SequenceWriter.hpp"
+#include "strata/core/Error.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -22,7 +23,7 @@ void WriteText(const std::filesystem::path& path, const std::string& text) {
     std::ofstream out(path);
     out << text;
     out.close();
-    if (!out) throw std::runtime_error("cannot write " + path.string());
+    if (!out) throw IoError("cannot write " + path.string());
 }
 
 std::string Row3x4(const Eigen::Matrix<double, 3, 4>& m) {
@@ -41,7 +42,7 @@ SequenceWriter::SequenceWriter(std::filesystem::path dir) : dir_(std::move(dir))
     for (const char* sub : {"velodyne", "labels"}) {
         std::filesystem::create_directories(dir_ / sub, ec);
         if (ec)
-            throw std::runtime_error("cannot create " + (dir_ / sub).string() + ": " +
+            throw IoError("cannot create " + (dir_ / sub).string() + ": " +
                                      ec.message());
     }
 }

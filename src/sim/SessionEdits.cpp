@@ -1,4 +1,5 @@
 #include "SessionEdits.hpp"
+#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,7 +29,7 @@ void MoveObject(ObjectSpec& o, const Eigen::Vector3d& to, double yaw_deg, const 
     } else if (auto* pole = std::get_if<PoleSpec>(&o.shape)) {
         pole->base = to;
     } else {
-        throw std::invalid_argument(at + ": only vehicles, boxes, plants and poles can move");
+        throw FormatError(at + ": only vehicles, boxes, plants and poles can move");
     }
 }
 
@@ -36,7 +37,7 @@ void MoveObject(ObjectSpec& o, const Eigen::Vector3d& to, double yaw_deg, const 
 
 SessionObjects ApplySessionEdits(const SceneSpec& spec, size_t session) {
     if (session >= spec.sessions.size()) {
-        throw std::invalid_argument(spec.source + ": no session " + std::to_string(session));
+        throw FormatError(spec.source + ": no session " + std::to_string(session));
     }
     SessionObjects out;
     out.objects = spec.objects;
@@ -48,14 +49,14 @@ SessionObjects ApplySessionEdits(const SceneSpec& spec, size_t session) {
                                          [&](const ObjectSpec& o) { return o.name == e.object; });
             if (e.kind == EditSpec::Kind::kAdd) {
                 if (it != out.objects.end()) {
-                    throw std::invalid_argument(at + ": object '" + e.object + "' already exists");
+                    throw FormatError(at + ": object '" + e.object + "' already exists");
                 }
                 out.objects.push_back(*e.added);
                 if (record) out.edits.push_back(Truth(*e.added, "added", "add"));
                 continue;
             }
             if (it == out.objects.end()) {
-                throw std::invalid_argument(at + ": edit of unknown object '" + e.object + "'");
+                throw FormatError(at + ": edit of unknown object '" + e.object + "'");
             }
             ObjectSpec& o = *it;
             if (e.kind == EditSpec::Kind::kRemove) {
@@ -67,7 +68,7 @@ SessionObjects ApplySessionEdits(const SceneSpec& spec, size_t session) {
                 if (record) out.edits.push_back(Truth(o, "added", "move"));
             } else if (e.kind == EditSpec::Kind::kDemolish) {
                 auto* w = std::get_if<WallSpec>(&o.shape);
-                if (w == nullptr) throw std::invalid_argument(at + ": only walls are demolished");
+                if (w == nullptr) throw FormatError(at + ": only walls are demolished");
                 // A full-height cut through the wall over [u0, u1].
                 w->openings.push_back({e.u0, e.u1, -1.0, w->height_m + 1.0, -1.0});
                 const WallFrame frame(*w);
@@ -85,7 +86,7 @@ SessionObjects ApplySessionEdits(const SceneSpec& spec, size_t session) {
                 if (record) out.edits.push_back(t);
             } else if (e.kind == EditSpec::Kind::kGrow) {
                 auto* p = std::get_if<PlantSpec>(&o.shape);
-                if (p == nullptr) throw std::invalid_argument(at + ": only plants grow");
+                if (p == nullptr) throw FormatError(at + ": only plants grow");
                 if (!p->tree) p->crown_center_height_m *= e.scale;  // a bush stays on the ground
                 p->crown_radii *= e.scale;
                 if (record) out.edits.push_back(Truth(o, "added", "grow"));

@@ -13,7 +13,7 @@ struct SessionObjects {
     std::vector<EditTruth> edits;  ///< changes of this session relative to the one before
 };
 
-/// Objects of a session and its edits; throws std::invalid_argument for an edit that does
+/// Objects of a session and its edits; throws FormatError for an edit that does
 /// not fit its object (unknown name, moving a wall, demolishing a vehicle, ...).
 [[nodiscard]] SessionObjects ApplySessionEdits(const SceneSpec& spec, size_t session);
 

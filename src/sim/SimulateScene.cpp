@@ -1,4 +1,5 @@
 #include "strata/sim/SimulateScene.hpp"
+#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -101,12 +102,12 @@ SessionReport SimulateSession(const SceneSpec& spec, size_t s, const std::filesy
 
 void SimulateConfig::Validate() const {
     if (!sensor.empty()) (void)SensorModel::FromName(sensor);
-    if (max_scans < 0) throw std::invalid_argument("max_scans must be >= 0");
+    if (max_scans < 0) throw InvalidArgumentError("max_scans must be >= 0");
     if (range_noise_m && !(*range_noise_m >= 0.0)) {
-        throw std::invalid_argument("range noise must be >= 0");
+        throw InvalidArgumentError("range noise must be >= 0");
     }
     if (!(surface_spacing_m >= 0.01)) {
-        throw std::invalid_argument("surface spacing must be at least 0.01 m");
+        throw InvalidArgumentError("surface spacing must be at least 0.01 m");
     }
     picture.Validate();
 }

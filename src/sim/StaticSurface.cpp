@@ -1,4 +1,5 @@
 #include "strata/sim/StaticSurface.hpp"
+#include "strata/core/Error.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -21,7 +22,7 @@ constexpr size_t kOriginsTried = 8;
 }  // namespace
 
 SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m, uint64_t seed) {
-    if (!(spacing_m > 0.0)) throw std::invalid_argument("surface spacing must be positive");
+    if (!(spacing_m > 0.0)) throw InvalidArgumentError("surface spacing must be positive");
     const double density = 1.0 / (spacing_m * spacing_m);
     SurfaceSample sample;
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
@@ -101,7 +102,7 @@ void WriteSurfacePly(const std::filesystem::path& path, const SurfaceSample& sam
         out.write(reinterpret_cast<const char*>(&sample.observed[i]), sizeof(uint8_t));
     }
     out.close();
-    if (!out) throw std::runtime_error("cannot write " + path.string());
+    if (!out) throw IoError("cannot write " + path.string());
 }
 
 }  // namespace strata::sim

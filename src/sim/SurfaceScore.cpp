@@ -1,4 +1,5 @@
 #include "strata/sim/SurfaceScore.hpp"
+#include "strata/core/Error.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -94,10 +95,10 @@ SurfaceScore ScoreSurface(const std::vector<Eigen::Vector3d>& map_points, const 
                           const std::vector<Eigen::Vector3d>& reference_points, double threshold_m,
                           double max_distance_m) {
     if (map_points.empty() || reference_points.empty()) {
-        throw std::invalid_argument("surface score: no map or no reference points");
+        throw InvalidArgumentError("surface score: no map or no reference points");
     }
     if (!(threshold_m > 0.0 && max_distance_m >= threshold_m)) {
-        throw std::invalid_argument("surface score: 0 < threshold <= max distance");
+        throw InvalidArgumentError("surface score: 0 < threshold <= max distance");
     }
     std::vector<Mesh> statics;
     for (const Mesh& m : scene.meshes) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "EmbreeScene.hpp"
 #include "Rng.hpp"
@@ -48,74 +49,96 @@ Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3
     return T;
 }
 
+// What every column of one sweep shares: the scene, the sensor, its beams' elevations and the
+// key of the sweep's random draws.
+struct SweepContext {
+    const EmbreeScene& embree;
+    const std::vector<float>& reflectivity;  // per mesh
+    const SensorModel& sensor;
+    std::vector<float> cos_el, sin_el;       // per beam
+    uint64_t key;
+
+    SweepContext(const EmbreeScene& embree_scene, const std::vector<float>& mesh_reflectivity,
+                 const SensorModel& model, uint64_t sweep_key)
+        : embree(embree_scene), reflectivity(mesh_reflectivity), sensor(model), key(sweep_key) {
+        for (const double elevation_deg : sensor.elevation_deg) {
+            const double e = elevation_deg * M_PI / 180.0;
+            cos_el.push_back(static_cast<float>(std::cos(e)));
+            sin_el.push_back(static_cast<float>(std::sin(e)));
+        }
+    }
+};
+
+// Pose of the sensor when column `col` fires (interpolated when the request gives an end pose).
+Eigen::Isometry3d ColumnPose(const SweepRequest& request, const SensorModel& sensor, int col) {
+    if (!request.T_world_sensor_end) return request.T_world_sensor;
+    return Interpolate(request.T_world_sensor, *request.T_world_sensor_end,
+                       sensor.ColumnTimeS(col) * sensor.rate_hz);
+}
+
+// Traces every beam of column c and appends its returns (dropout, grazing cut, range noise and
+// Lambertian intensity applied) to `out`.
+void TraceColumn(const SweepContext& ctx, const Eigen::Isometry3d& T, size_t c,
+                 std::vector<RaySample>& out) {
+    const SensorModel& sensor = ctx.sensor;
+    const size_t beams = ctx.cos_el.size();
+    const Eigen::Matrix3f R = T.linear().cast<float>();
+    const Eigen::Vector3f origin = T.translation().cast<float>();
+    const double az = sensor.ColumnAzimuthRad(static_cast<int>(c));
+    const auto ca = static_cast<float>(std::cos(az));
+    const auto sa = static_cast<float>(std::sin(az));
+    // Beams of a column leave one origin in similar directions: trace packets of 8.
+    Eigen::Vector3f dir_sensor[8], dir[8];
+    EmbreeScene::Hit hits[8];
+    for (size_t b0 = 0; b0 < beams; b0 += 8) {
+        const size_t count = std::min<size_t>(8, beams - b0);
+        for (size_t i = 0; i < count; ++i) {
+            const size_t b = b0 + i;
+            dir_sensor[i] = Eigen::Vector3f(ctx.cos_el[b] * ca, ctx.cos_el[b] * sa, ctx.sin_el[b]);
+            dir[i] = R * dir_sensor[i];
+        }
+        ctx.embree.Intersect8(origin, dir, static_cast<int>(count),
+                              static_cast<float>(sensor.max_range_m), hits);
+        for (size_t i = 0; i < count; ++i) {
+            const EmbreeScene::Hit& hit = hits[i];
+            if (hit.geometry == RTC_INVALID_GEOMETRY_ID) continue;
+            // Random draws keyed by (seed, scan, ray): independent of threads.
+            const uint64_t h = detail::Mix64(ctx.key ^ (c * beams + b0 + i));
+            if (ToUnit(h) < sensor.dropout_probability) continue;
+            // |cos| of the incidence angle (dir is a unit vector, the normal not).
+            const float cos_inc = std::abs(hit.normal.dot(dir[i])) / hit.normal.norm();
+            if (cos_inc < sensor.grazing_cos) continue;
+            const Eigen::Vector2f noise = NormalPair(h);
+            const double range = hit.t + sensor.range_noise_m * noise.x();
+            if (range < sensor.min_range_m || range > sensor.max_range_m) continue;
+            // Lambertian return: albedo times the cosine of the incidence angle.
+            const double intensity =
+                ctx.reflectivity[hit.geometry] * cos_inc + sensor.intensity_noise * noise.y();
+            out.push_back({dir_sensor[i] * static_cast<float>(range),
+                           static_cast<float>(std::clamp(intensity, 0.0, 1.0)), hit.geometry,
+                           static_cast<uint16_t>(b0 + i), static_cast<uint16_t>(c)});
+        }
+    }
+}
+
 }  // namespace
 
 SimulatedScan Simulator::SimulateSweep(const SweepRequest& request,
                                        const SensorModel& sensor) const {
     sensor.Validate();
+    const SweepContext ctx(*embree_, reflectivity_, sensor,
+                           detail::HashKey(request.seed, request.scan_index, 0x5CA7));
     const size_t beams = sensor.beams();
     const auto columns = static_cast<size_t>(sensor.columns);
-    std::vector<float> cos_el(beams), sin_el(beams);
-    for (size_t b = 0; b < beams; ++b) {
-        const double e = sensor.elevation_deg[b] * M_PI / 180.0;
-        cos_el[b] = static_cast<float>(std::cos(e));
-        sin_el[b] = static_cast<float>(std::sin(e));
-    }
-    const auto max_range = static_cast<float>(sensor.max_range_m);
-    const uint64_t key = detail::HashKey(request.seed, request.scan_index, 0x5CA7);
     // Chunks of columns, each with its own small buffer of returns (reused from the allocator's
     // pools: no large buffer to fault in per sweep), concatenated in order afterwards.
     constexpr size_t kChunk = 32;
     std::vector<std::vector<RaySample>> chunks((columns + kChunk - 1) / kChunk);
-    // Range: chunks of columns; each task traces all beams of its columns.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size()), [&](const auto& chunk_range) {
         for (size_t k = chunk_range.begin(); k != chunk_range.end(); ++k) {
-            std::vector<RaySample>& out = chunks[k];
-            out.reserve(kChunk * beams);
+            chunks[k].reserve(kChunk * beams);
             for (size_t c = k * kChunk; c < std::min(columns, (k + 1) * kChunk); ++c) {
-                const int col = static_cast<int>(c);
-                const Eigen::Isometry3d T =
-                    request.T_world_sensor_end
-                        ? Interpolate(request.T_world_sensor, *request.T_world_sensor_end,
-                                      sensor.ColumnTimeS(col) * sensor.rate_hz)
-                        : request.T_world_sensor;
-                const Eigen::Matrix3f R = T.linear().cast<float>();
-                const Eigen::Vector3f origin = T.translation().cast<float>();
-                const double az = sensor.ColumnAzimuthRad(col);
-                const auto ca = static_cast<float>(std::cos(az));
-                const auto sa = static_cast<float>(std::sin(az));
-                // Beams of a column leave one origin in similar directions: trace packets of 8.
-                Eigen::Vector3f dir_sensor[8], dir[8];
-                EmbreeScene::Hit hits[8];
-                for (size_t b0 = 0; b0 < beams; b0 += 8) {
-                    const size_t count = std::min<size_t>(8, beams - b0);
-                    for (size_t i = 0; i < count; ++i) {
-                        const size_t b = b0 + i;
-                        dir_sensor[i] = Eigen::Vector3f(cos_el[b] * ca, cos_el[b] * sa, sin_el[b]);
-                        dir[i] = R * dir_sensor[i];
-                    }
-                    embree_->Intersect8(origin, dir, static_cast<int>(count), max_range, hits);
-                    for (size_t i = 0; i < count; ++i) {
-                        const EmbreeScene::Hit& hit = hits[i];
-                        if (hit.geometry == RTC_INVALID_GEOMETRY_ID) continue;
-                        // Random draws keyed by (seed, scan, ray): independent of threads.
-                        const uint64_t h = detail::Mix64(key ^ (c * beams + b0 + i));
-                        if (ToUnit(h) < sensor.dropout_probability) continue;
-                        // |cos| of the incidence angle (dir is a unit vector, the normal not).
-                        const float cos_inc = std::abs(hit.normal.dot(dir[i])) / hit.normal.norm();
-                        if (cos_inc < sensor.grazing_cos) continue;
-                        const Eigen::Vector2f noise = NormalPair(h);
-                        const double range = hit.t + sensor.range_noise_m * noise.x();
-                        if (range < sensor.min_range_m || range > sensor.max_range_m) continue;
-                        // Lambertian return: albedo times the cosine of the incidence angle.
-                        const double intensity = reflectivity_[hit.geometry] * cos_inc +
-                                                 sensor.intensity_noise * noise.y();
-                        out.push_back({dir_sensor[i] * static_cast<float>(range),
-                                       static_cast<float>(std::clamp(intensity, 0.0, 1.0)),
-                                       hit.geometry, static_cast<uint16_t>(b0 + i),
-                                       static_cast<uint16_t>(c)});
-                    }
-                }
+                TraceColumn(ctx, ColumnPose(request, sensor, static_cast<int>(c)), c, chunks[k]);
             }
         }
     });

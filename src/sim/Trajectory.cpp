@@ -1,4 +1,5 @@
 #include "strata/sim/Trajectory.hpp"
+#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,7 @@ Trajectory::Trajectory(std::vector<Eigen::Vector3d> positions_world, double spee
                        double turn_blend_m)
     : positions_(std::move(positions_world)), speed_mps_(speed_mps), blend_m_(turn_blend_m) {
     if (positions_.empty() || !(speed_mps_ > 0.0)) {
-        throw std::invalid_argument("trajectory needs at least one position and a speed > 0");
+        throw InvalidArgumentError("trajectory needs at least one position and a speed > 0");
     }
     arclength_.push_back(0.0);
     for (size_t i = 0; i + 1 < positions_.size(); ++i) {
@@ -66,14 +67,14 @@ Eigen::Isometry3d Trajectory::PoseAt(double t_s) const {
 
 std::vector<ScanPose> PlanScanPoses(const TrajectorySpec& trajectory, const Simulator& simulator,
                                     double rate_hz) {
-    if (!(rate_hz > 0.0)) throw std::invalid_argument("sensor rate must be positive");
+    if (!(rate_hz > 0.0)) throw InvalidArgumentError("sensor rate must be positive");
     std::vector<Eigen::Vector3d> positions;
     for (const Eigen::Vector3d& w : trajectory.waypoints) {
         double floor_z = w.z();
         if (std::isnan(floor_z)) {
             const std::optional<double> ground = simulator.GroundHeight(w.x(), w.y(), 1e3);
             if (!ground) {
-                throw std::invalid_argument("no ground under waypoint (" + std::to_string(w.x()) +
+                throw InvalidArgumentError("no ground under waypoint (" + std::to_string(w.x()) +
                                             ", " + std::to_string(w.y()) + ")");
             }
             floor_z = *ground;

@@ -1,6 +1,7 @@
 #include <stdexcept>
 
 #include "MeshBuilders.hpp"
+#include "strata/core/Error.hpp"
 #include "ObjectGeometry.hpp"
 #include "strata/sim/KittiIds.hpp"
 
@@ -46,7 +47,7 @@ Shape ShapeOf(const std::string& type) {
                 0.15,
                 0.36};
     }
-    throw std::invalid_argument("unknown vehicle type '" + type + "' (car, suv, van, truck)");
+    throw InvalidArgumentError("unknown vehicle type '" + type + "' (car, suv, van, truck)");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "strata/vehicles/GroundField.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -20,42 +22,52 @@ struct Lowest {
     bool ground_label = false;
 };
 
-// 8-neighbourhood of a column.
-constexpr int kDi[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
-constexpr int kDj[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+// The columns a field covers, row by row, and their 8-neighbourhoods.
+struct Raster {
+    int min_i = 0, min_j = 0, width = 0, height = 0;
 
-}  // namespace
-
-GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& config) {
-    if (!(config.max_step_m > 0.0 && config.min_area_m2 >= 0.0 && config.fill_radius_m >= 0.0)) {
-        throw std::invalid_argument("ground: max_step_m > 0, min_area_m2 >= 0, fill_radius_m >= 0");
+    [[nodiscard]] size_t Size() const { return static_cast<size_t>(width) * height; }
+    [[nodiscard]] size_t Index(int i, int j) const {
+        return static_cast<size_t>(j - min_j) * width + (i - min_i);
     }
-    GroundField field;
-    const openvdb::CoordBBox box = map.occupancy->evalActiveVoxelBoundingBox();
-    if (box.empty()) return field;
-    field.min_i_ = box.min().x(), field.min_j_ = box.min().y();
-    field.width_ = box.dim().x(), field.height_ = box.dim().y();
-    const size_t n = static_cast<size_t>(field.width_) * field.height_;
+    // Calls visit(m) for each neighbour m of column c inside the raster.
+    template <typename Visit>
+    void ForNeighbours(size_t c, Visit&& visit) const {
+        constexpr int kDi[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+        constexpr int kDj[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+        const int i = static_cast<int>(c % width) + min_i;
+        const int j = static_cast<int>(c / width) + min_j;
+        for (int d = 0; d < 8; ++d) {
+            const int ni = i + kDi[d], nj = j + kDj[d];
+            if (ni >= min_i && nj >= min_j && ni < min_i + width && nj < min_j + height) {
+                visit(Index(ni, nj));
+            }
+        }
+    }
+};
 
-    // Step 1: the lowest occupied voxel of each column.
-    std::vector<Lowest> lowest(n);
+std::vector<Lowest> LowestOfColumns(const core::VoxelMap& map, const Raster& raster) {
+    std::vector<Lowest> lowest(raster.Size());
     auto label = map.label->getConstAccessor();
     for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
         if (*it <= 0.0F) continue;
         const openvdb::Coord ijk = it.getCoord();
-        Lowest& l = lowest[field.Index(ijk.x(), ijk.y())];
+        Lowest& l = lowest[raster.Index(ijk.x(), ijk.y())];
         if (ijk.z() >= l.k) continue;
         l.k = ijk.z();
         l.z = static_cast<float>(map.PointMean(ijk).z());
         l.ground_label = label.getValue(ijk) == static_cast<int>(core::SemanticClass::kGround);
     }
+    return lowest;
+}
 
-    // Step 2: ground columns. Labelled maps: the lowest voxel is labelled ground. Otherwise
-    // regions of columns whose lowest voxels step by at most max_step_m, large enough and not
-    // standing above their surroundings (a roof is a flat region higher than its rim).
-    field.z_.assign(n, kUnknown);
-    field.measured_.assign(n, 0);
-    const double column_area = map.voxel_size * map.voxel_size;
+// Ground columns (1) of the raster. Labelled maps: the lowest voxel is labelled ground.
+// Otherwise regions of columns whose lowest voxels step by at most max_step_m, large enough and
+// not standing above their surroundings (a roof is a flat region higher than its rim).
+std::vector<uint8_t> GroundColumns(const std::vector<Lowest>& lowest, const Raster& raster,
+                                   const GroundConfig& config, double column_area) {
+    const size_t n = raster.Size();
+    std::vector<uint8_t> ground(n, 0);
     std::vector<int32_t> region(n, -1);
     std::vector<size_t> queue;
     for (size_t seed = 0; seed < n; ++seed) {
@@ -66,12 +78,8 @@ GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& 
         size_t rim_pairs = 0, rim_lower = 0;
         for (size_t q = 0; q < queue.size(); ++q) {
             const size_t c = queue[q];
-            const int i = static_cast<int>(c % field.width_) + field.min_i_;
-            const int j = static_cast<int>(c / field.width_) + field.min_j_;
-            for (int d = 0; d < 8; ++d) {
-                if (!field.Inside(i + kDi[d], j + kDj[d])) continue;
-                const size_t m = field.Index(i + kDi[d], j + kDj[d]);
-                if (std::isnan(lowest[m].z) || region[m] == static_cast<int32_t>(seed)) continue;
+            raster.ForNeighbours(c, [&](size_t m) {
+                if (std::isnan(lowest[m].z) || region[m] == static_cast<int32_t>(seed)) return;
                 const bool joins = std::abs(lowest[m].z - lowest[c].z) <= config.max_step_m &&
                                    region[m] < 0 && (!config.use_labels || lowest[m].ground_label);
                 if (joins) {
@@ -81,7 +89,7 @@ GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& 
                     ++rim_pairs;
                     if (lowest[m].z < lowest[c].z - config.max_step_m) ++rim_lower;
                 }
-            }
+            });
         }
         // A region several times the smallest ground is ground even when most of its rim drops
         // (a deck with a drain, a garage floor cut by a ramp).
@@ -90,46 +98,62 @@ GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& 
         const bool raised = !config.use_labels && area < 4.0 * config.min_area_m2 &&
                             rim_pairs > 0 && 2 * rim_lower > rim_pairs;
         if (!large || raised) continue;
-        for (size_t c : queue) field.z_[c] = lowest[c].z, field.measured_[c] = 1;
+        for (size_t c : queue) ground[c] = 1;
     }
+    return ground;
+}
 
-    // Step 3: fill columns without ground ring by ring from their known neighbours (mean);
-    // each pass visits only the columns next to the ones the pass before filled.
-    const int passes = static_cast<int>(std::ceil(config.fill_radius_m / map.voxel_size));
-    std::vector<uint8_t> queued(n, 0);
+// Fills unknown heights ring by ring from their known neighbours (mean), `passes` rings deep;
+// each pass visits only the columns next to the ones the pass before filled.
+void FillHoles(std::vector<float>& z, const Raster& raster, int passes) {
+    std::vector<uint8_t> queued(z.size(), 0);
     std::vector<size_t> frontier, next;
     auto enqueue_unknown_neighbours = [&](size_t c, std::vector<size_t>& into) {
-        const int i = static_cast<int>(c % field.width_) + field.min_i_;
-        const int j = static_cast<int>(c / field.width_) + field.min_j_;
-        for (int d = 0; d < 8; ++d) {
-            if (!field.Inside(i + kDi[d], j + kDj[d])) continue;
-            const size_t m = field.Index(i + kDi[d], j + kDj[d]);
-            if (std::isnan(field.z_[m]) && !queued[m]) queued[m] = 1, into.push_back(m);
-        }
+        raster.ForNeighbours(c, [&](size_t m) {
+            if (std::isnan(z[m]) && !queued[m]) queued[m] = 1, into.push_back(m);
+        });
     };
-    for (size_t c = 0; c < n; ++c) {
-        if (field.measured_[c]) enqueue_unknown_neighbours(c, frontier);
+    for (size_t c = 0; c < z.size(); ++c) {
+        if (!std::isnan(z[c])) enqueue_unknown_neighbours(c, frontier);
     }
     std::vector<std::pair<size_t, float>> filled;
     for (int pass = 0; pass < passes && !frontier.empty(); ++pass) {
         filled.clear();
         for (size_t c : frontier) {
-            const int i = static_cast<int>(c % field.width_) + field.min_i_;
-            const int j = static_cast<int>(c / field.width_) + field.min_j_;
             double sum = 0.0;
             int count = 0;
-            for (int d = 0; d < 8; ++d) {
-                if (!field.Inside(i + kDi[d], j + kDj[d])) continue;
-                const float z = field.z_[field.Index(i + kDi[d], j + kDj[d])];
-                if (!std::isnan(z)) sum += z, ++count;
-            }
+            raster.ForNeighbours(c, [&](size_t m) {
+                if (!std::isnan(z[m])) sum += z[m], ++count;
+            });
             filled.emplace_back(c, static_cast<float>(sum / count));
         }
-        for (const auto& [c, z] : filled) field.z_[c] = z;
+        for (const auto& [c, value] : filled) z[c] = value;
         next.clear();
-        for (const auto& [c, z] : filled) enqueue_unknown_neighbours(c, next);
+        for (const auto& [c, value] : filled) enqueue_unknown_neighbours(c, next);
         frontier.swap(next);
     }
+}
+
+}  // namespace
+
+GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& config) {
+    if (!(config.max_step_m > 0.0 && config.min_area_m2 >= 0.0 && config.fill_radius_m >= 0.0)) {
+        throw InvalidArgumentError("ground: max_step_m > 0, min_area_m2 >= 0, fill_radius_m >= 0");
+    }
+    GroundField field;
+    const openvdb::CoordBBox box = map.occupancy->evalActiveVoxelBoundingBox();
+    if (box.empty()) return field;
+    const Raster raster{box.min().x(), box.min().y(), box.dim().x(), box.dim().y()};
+    field.min_i_ = raster.min_i, field.min_j_ = raster.min_j;
+    field.width_ = raster.width, field.height_ = raster.height;
+
+    const std::vector<Lowest> lowest = LowestOfColumns(map, raster);
+    field.measured_ = GroundColumns(lowest, raster, config, map.voxel_size * map.voxel_size);
+    field.z_.assign(raster.Size(), kUnknown);
+    for (size_t c = 0; c < raster.Size(); ++c) {
+        if (field.measured_[c]) field.z_[c] = lowest[c].z;
+    }
+    FillHoles(field.z_, raster, static_cast<int>(std::ceil(config.fill_radius_m / map.voxel_size)));
     return field;
 }
 

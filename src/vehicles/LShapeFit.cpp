@@ -1,5 +1,7 @@
 #include "strata/vehicles/LShapeFit.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -116,9 +118,9 @@ std::vector<Eigen::Vector2d> OrientedRect::Corners() const {
 }
 
 OrientedRect FitLShape(const std::vector<Eigen::Vector2d>& points, double step_deg) {
-    if (points.size() < 2) throw std::invalid_argument("L-shape fitting needs at least 2 points");
+    if (points.size() < 2) throw InvalidArgumentError("L-shape fitting needs at least 2 points");
     if (!(step_deg > 0.0 && step_deg <= 45.0)) {
-        throw std::invalid_argument("L-shape heading step must be in (0, 45] degrees");
+        throw InvalidArgumentError("L-shape heading step must be in (0, 45] degrees");
     }
     // Range: headings [0, 90) degrees; beyond, the two edges swap roles.
     double best_theta = 0.0, best = std::numeric_limits<double>::max();

@@ -1,5 +1,7 @@
 #include "OcclusionScene.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <array>
 #include <limits>
 #include <stdexcept>
@@ -47,7 +49,7 @@ OcclusionScene::OcclusionScene(const std::vector<openvdb::Coord>& voxels, double
     faces_ = vertices.size() / 4;
     device_ = rtcNewDevice("verbose=0");
     if (device_ == nullptr) {
-        throw std::runtime_error("Embree: cannot create a device (error " +
+        throw Error("Embree: cannot create a device (error " +
                                  std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     }
     scene_ = rtcNewScene(device_);
@@ -117,7 +119,7 @@ bool OcclusionScene::Blocked(const Eigen::Vector3d& from, const Eigen::Vector3d&
 void OcclusionScene::Fail(const std::string& what) {
     const RTCError code = rtcGetDeviceError(device_);
     Release();
-    throw std::runtime_error("Embree: " + what + " (error " + std::to_string(int(code)) + ")");
+    throw Error("Embree: " + what + " (error " + std::to_string(int(code)) + ")");
 }
 
 void OcclusionScene::Release() noexcept {

@@ -1,5 +1,7 @@
 #include "strata/vehicles/Vehicles.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <set>
@@ -17,14 +19,14 @@ constexpr double kRadToDeg = 57.29577951308232;
 void Validate(const core::VoxelMap& map, const VehicleConfig& c) {
     if (!map.occupancy || !map.label || !map.label_weight || !map.endpoints ||
         !(map.voxel_size > 0.0)) {
-        throw std::invalid_argument("vehicles: the map is not initialised (use VoxelMap::Create)");
+        throw InvalidArgumentError("vehicles: the map is not initialised (use VoxelMap::Create)");
     }
     const bool ok = c.min_voxel_height_m > 0.0 && c.max_voxel_height_m > c.min_voxel_height_m &&
                     c.gap_m >= 0.0 && c.max_length_m > 0.0 && c.max_width_m > 0.0 &&
                     c.heading_step_deg > 0.0 && c.heading_step_deg <= 45.0 &&
                     c.split_length_m > 0.0 && c.split_width_m > 0.0 && c.ring_width_m > 0.0 &&
                     c.ring_gap_m >= 0.0 && c.ray_range_m > 0.0 && c.max_origins > 0;
-    if (!ok) throw std::invalid_argument("vehicles: a configuration value is out of range");
+    if (!ok) throw InvalidArgumentError("vehicles: a configuration value is out of range");
 }
 
 // Labels when the map has vehicle-labelled voxels, else the geometric detector.
@@ -55,7 +57,7 @@ VehicleSource SourceFromName(const std::string& name) {
     if (name == "auto") return VehicleSource::kAuto;
     if (name == "label") return VehicleSource::kLabel;
     if (name == "geometric") return VehicleSource::kGeometric;
-    throw std::invalid_argument("unknown vehicle source '" + name + "' (auto, label, geometric)");
+    throw InvalidArgumentError("unknown vehicle source '" + name + "' (auto, label, geometric)");
 }
 
 Eigen::Vector3d Vehicle::Center() const {

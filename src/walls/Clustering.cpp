@@ -1,17 +1,20 @@
 #include "strata/walls/Clustering.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 #include <stdexcept>
 
 namespace strata::walls {
 
 std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
                         int min_points) {
-    if (!(eps_voxels >= 1.0)) throw std::invalid_argument("DBSCAN: eps must be >= 1 voxel");
-    if (min_points < 1) throw std::invalid_argument("DBSCAN: min_points must be >= 1");
+    if (!(eps_voxels >= 1.0)) throw InvalidArgumentError("DBSCAN: eps must be >= 1 voxel");
+    if (min_points < 1) throw InvalidArgumentError("DBSCAN: min_points must be >= 1");
     // The grid is the index: voxel -> position in `voxels` + 1 (0 = background).
     auto index = openvdb::Int32Grid::create(0);
     {
@@ -71,16 +74,13 @@ std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_vo
     return label;
 }
 
-std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint64_t seed,
-                        int max_iterations) {
+namespace {
+
+// k-means++: each next centre drawn with probability proportional to the squared distance to the
+// nearest centre chosen so far. Fewer than k centres when there are fewer distinct points.
+std::vector<Eigen::Vector3d> SeedCentres(const std::vector<Eigen::Vector3d>& points, int k,
+                                         std::mt19937_64& rng) {
     const size_t n = points.size();
-    std::vector<int> assignment(n, 0);
-    if (n == 0) return assignment;
-    k = std::clamp(k, 1, static_cast<int>(n));
-    if (k == 1) return assignment;
-    std::mt19937_64 rng(seed);
-    // k-means++: each next centre drawn with probability proportional to the squared distance
-    // to the nearest centre chosen so far.
     std::vector<Eigen::Vector3d> centres;
     centres.push_back(points[std::uniform_int_distribution<size_t>(0, n - 1)(rng)]);
     std::vector<double> d2(n, std::numeric_limits<double>::max());
@@ -90,7 +90,7 @@ std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint6
             d2[i] = std::min(d2[i], (points[i] - centres.back()).squaredNorm());
             total += d2[i];
         }
-        if (total <= 0.0) break;  // fewer distinct points than k
+        if (total <= 0.0) break;
         double pick = std::uniform_real_distribution<double>(0.0, total)(rng);
         size_t chosen = n - 1;
         for (size_t i = 0; i < n; ++i) {
@@ -102,17 +102,56 @@ std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint6
         }
         centres.push_back(points[chosen]);
     }
-    // Lloyd's iterations with Hamerly's bounds (2010): the same assignments as plain Lloyd, but a
-    // point is only compared with every centre when its distance bounds cannot rule a change
-    // out. upper[i] bounds the distance to its centre from above, lower[i] the distance to any
-    // other centre from below.
-    const int kk = static_cast<int>(centres.size());
-    std::vector<double> upper(n), lower(n), half_gap(kk), moved(kk);
-    const auto nearest_two = [&](size_t i) {
+    return centres;
+}
+
+// Lloyd's iterations with Hamerly's bounds (2010): the same assignments as plain Lloyd, but a
+// point is only compared with every centre when its distance bounds cannot rule a change out.
+// upper[i] bounds the distance to its centre from above, lower[i] the distance to any other
+// centre from below.
+class HamerlyLloyd {
+public:
+    HamerlyLloyd(const std::vector<Eigen::Vector3d>& points, std::vector<Eigen::Vector3d> centres,
+                 std::vector<int>& assignment)
+        : points_(points),
+          centres_(std::move(centres)),
+          assignment_(assignment),
+          upper_(points.size()),
+          lower_(points.size()),
+          moved_(centres_.size()) {
+        for (size_t i = 0; i < points_.size(); ++i) AssignNearest(i);
+    }
+
+    /// One iteration; false once no centre moves (then no point would change either).
+    bool Step() {
+        const auto [most, second, most_moved] = MoveCentres();
+        if (most == 0.0) return false;
+        for (size_t i = 0; i < points_.size(); ++i) {
+            upper_[i] += moved_[assignment_[i]];
+            lower_[i] -= assignment_[i] == most_moved ? second : most;
+        }
+        const std::vector<double> half_gap = HalfGaps();
+        for (size_t i = 0; i < points_.size(); ++i) {
+            const double bound = std::max(half_gap[assignment_[i]], lower_[i]);
+            if (upper_[i] <= bound) continue;
+            upper_[i] = (points_[i] - centres_[assignment_[i]]).norm();
+            if (upper_[i] <= bound) continue;
+            AssignNearest(i);
+        }
+        return true;
+    }
+
+private:
+    struct Movement {
+        double most = 0.0, second = 0.0;
+        int most_moved = -1;
+    };
+
+    void AssignNearest(size_t i) {
         double d1 = std::numeric_limits<double>::max(), d2nd = d1;
         int best = 0;
-        for (int c = 0; c < kk; ++c) {
-            const double d = (points[i] - centres[c]).norm();
+        for (int c = 0; c < static_cast<int>(centres_.size()); ++c) {
+            const double d = (points_[i] - centres_[c]).norm();
             if (d < d1) {
                 d2nd = d1;
                 d1 = d;
@@ -121,62 +160,75 @@ std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint6
                 d2nd = d;
             }
         }
-        assignment[i] = best;
-        upper[i] = d1;
-        lower[i] = d2nd;
-    };
-    for (size_t i = 0; i < n; ++i) nearest_two(i);
-    std::vector<Eigen::Vector3d> sums(kk);
-    std::vector<size_t> counts(kk);
-    for (int iteration = 0; iteration < max_iterations; ++iteration) {
-        // Move each centre to the mean of its points.
-        std::fill(sums.begin(), sums.end(), Eigen::Vector3d::Zero());
-        std::fill(counts.begin(), counts.end(), 0);
-        for (size_t i = 0; i < n; ++i) {
-            sums[assignment[i]] += points[i];
-            ++counts[assignment[i]];
+        assignment_[i] = best;
+        upper_[i] = d1;
+        lower_[i] = d2nd;
+    }
+
+    // Moves each centre to the mean of its points; the largest and second largest move.
+    Movement MoveCentres() {
+        const size_t k = centres_.size();
+        std::vector<Eigen::Vector3d> sums(k, Eigen::Vector3d::Zero());
+        std::vector<size_t> counts(k, 0);
+        for (size_t i = 0; i < points_.size(); ++i) {
+            sums[assignment_[i]] += points_[i];
+            ++counts[assignment_[i]];
         }
-        double most = 0.0, second = 0.0;
-        int most_moved = -1;
-        for (int c = 0; c < kk; ++c) {
+        Movement m;
+        for (size_t c = 0; c < k; ++c) {
             const Eigen::Vector3d next =
                 counts[c] > 0 ? Eigen::Vector3d(sums[c] / static_cast<double>(counts[c]))
-                              : centres[c];
-            moved[c] = (next - centres[c]).norm();
-            centres[c] = next;
-            if (moved[c] > most) {
-                second = most;
-                most = moved[c];
-                most_moved = c;
-            } else if (moved[c] > second) {
-                second = moved[c];
+                              : centres_[c];
+            moved_[c] = (next - centres_[c]).norm();
+            centres_[c] = next;
+            if (moved_[c] > m.most) {
+                m.second = m.most;
+                m.most = moved_[c];
+                m.most_moved = static_cast<int>(c);
+            } else if (moved_[c] > m.second) {
+                m.second = moved_[c];
             }
         }
-        if (most == 0.0) break;  // converged: no centre moved, so no point changes
-        for (size_t i = 0; i < n; ++i) {
-            upper[i] += moved[assignment[i]];
-            lower[i] -= assignment[i] == most_moved ? second : most;
-        }
-        for (int c = 0; c < kk; ++c) {
+        return m;
+    }
+
+    // Half the distance from each centre to its nearest other centre.
+    std::vector<double> HalfGaps() const {
+        std::vector<double> half_gap(centres_.size());
+        for (size_t c = 0; c < centres_.size(); ++c) {
             double gap = std::numeric_limits<double>::max();
-            for (int o = 0; o < kk; ++o) {
-                if (o != c) gap = std::min(gap, (centres[c] - centres[o]).norm());
+            for (size_t o = 0; o < centres_.size(); ++o) {
+                if (o != c) gap = std::min(gap, (centres_[c] - centres_[o]).norm());
             }
             half_gap[c] = 0.5 * gap;
         }
-        for (size_t i = 0; i < n; ++i) {
-            const double bound = std::max(half_gap[assignment[i]], lower[i]);
-            if (upper[i] <= bound) continue;
-            upper[i] = (points[i] - centres[assignment[i]]).norm();
-            if (upper[i] <= bound) continue;
-            nearest_two(i);
-        }
+        return half_gap;
+    }
+
+    const std::vector<Eigen::Vector3d>& points_;
+    std::vector<Eigen::Vector3d> centres_;
+    std::vector<int>& assignment_;
+    std::vector<double> upper_, lower_, moved_;
+};
+
+}  // namespace
+
+std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint64_t seed,
+                        int max_iterations) {
+    const size_t n = points.size();
+    std::vector<int> assignment(n, 0);
+    if (n == 0) return assignment;
+    k = std::clamp(k, 1, static_cast<int>(n));
+    if (k == 1) return assignment;
+    std::mt19937_64 rng(seed);
+    HamerlyLloyd lloyd(points, SeedCentres(points, k, rng), assignment);
+    for (int iteration = 0; iteration < max_iterations && lloyd.Step(); ++iteration) {
     }
     return assignment;
 }
 
 int PartsFor(size_t n, int divisor) {
-    if (divisor < 1) throw std::invalid_argument("K-means divisor must be >= 1");
+    if (divisor < 1) throw InvalidArgumentError("K-means divisor must be >= 1");
     return std::max(1, static_cast<int>(n / static_cast<size_t>(divisor)));
 }
 

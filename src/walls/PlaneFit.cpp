@@ -1,5 +1,7 @@
 #include "strata/walls/PlaneFit.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
@@ -27,9 +29,9 @@ struct PlaneResidual {
 }  // namespace
 
 PlaneFit FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& weights) {
-    if (points.size() < 3) throw std::invalid_argument("plane fit: needs at least 3 points");
+    if (points.size() < 3) throw InvalidArgumentError("plane fit: needs at least 3 points");
     if (!weights.empty() && weights.size() != points.size()) {
-        throw std::invalid_argument("plane fit: one weight per point expected");
+        throw InvalidArgumentError("plane fit: one weight per point expected");
     }
     const auto weight = [&](size_t i) { return weights.empty() ? 1.0 : weights[i]; };
     PlaneFit fit;
@@ -38,7 +40,7 @@ PlaneFit FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<
         fit.centroid += weight(i) * points[i];
         total += weight(i);
     }
-    if (!(total > 0.0)) throw std::invalid_argument("plane fit: the weights sum to zero");
+    if (!(total > 0.0)) throw InvalidArgumentError("plane fit: the weights sum to zero");
     fit.centroid /= total;
     fit.points = static_cast<size_t>(std::lround(total));
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
@@ -59,8 +61,8 @@ PlaneFit FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<
 RansacResult RansacPlane(const std::vector<Eigen::Vector3d>& points, double threshold,
                          int iterations, uint64_t seed) {
     const size_t n = points.size();
-    if (n < 3) throw std::invalid_argument("RANSAC plane: needs at least 3 points");
-    if (!(threshold > 0.0)) throw std::invalid_argument("RANSAC plane: threshold must be > 0");
+    if (n < 3) throw InvalidArgumentError("RANSAC plane: needs at least 3 points");
+    if (!(threshold > 0.0)) throw InvalidArgumentError("RANSAC plane: threshold must be > 0");
     std::mt19937_64 rng(seed);
     std::uniform_int_distribution<size_t> pick(0, n - 1);
     Plane best;
@@ -104,7 +106,7 @@ Plane RefinePlane(const std::vector<Eigen::Vector3d>& points, const Plane& initi
                   double loss_scale, const std::vector<double>& weights) {
     if (points.size() < 3) return initial;
     if (!weights.empty() && weights.size() != points.size()) {
-        throw std::invalid_argument("plane refinement: one weight per point expected");
+        throw InvalidArgumentError("plane refinement: one weight per point expected");
     }
     double n[3] = {initial.normal.x(), initial.normal.y(), initial.normal.z()};
     double d[1] = {initial.d};

@@ -1,5 +1,7 @@
 #include "strata/walls/Walls.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -20,7 +22,7 @@ double Seconds(Clock::time_point since) {
 }
 
 void Require(bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(std::string("wall config: ") + what);
+    if (!ok) throw InvalidArgumentError(std::string("wall config: ") + what);
 }
 
 // An accepted part, before merging.
@@ -384,7 +386,7 @@ private:
 
 WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     config.Validate();
-    if (!map.occupancy) throw std::invalid_argument("walls: the map has no occupancy grid");
+    if (!map.occupancy) throw InvalidArgumentError("walls: the map has no occupancy grid");
     WallResult result;
     const double s = map.voxel_size;
     result.voxel_size = s;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "strata/core/Error.hpp"
 #include "strata/change/ChangeDetection.hpp"
 
 namespace strata::change {
@@ -230,8 +231,8 @@ TEST(ChangeDetection, MissingMasksAreRefused) {
     const Street s;
     Observation broken = s.b;
     broken.masks.free.reset();
-    EXPECT_THROW((void)DetectChanges(s.a, broken, kVoxel), std::invalid_argument);
-    EXPECT_THROW((void)DetectChanges(s.a, s.b, 0.0), std::invalid_argument);
+    EXPECT_THROW((void)DetectChanges(s.a, broken, kVoxel), InvalidArgumentError);
+    EXPECT_THROW((void)DetectChanges(s.a, s.b, 0.0), InvalidArgumentError);
 }
 
 TEST(Region, ParsesBoxesAndPolygonsAndNamesBadText) {
@@ -247,7 +248,7 @@ TEST(Region, ParsesBoxesAndPolygonsAndNamesBadText) {
         try {
             (void)core::Region::Parse(bad);
             ADD_FAILURE() << "accepted '" << bad << "'";
-        } catch (const std::invalid_argument& e) {
+        } catch (const InvalidArgumentError& e) {
             EXPECT_NE(std::string(e.what()).find("region"), std::string::npos) << e.what();
         }
     }

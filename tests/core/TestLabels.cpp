@@ -1,3 +1,4 @@
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 
 #include <gtest/gtest.h>
@@ -30,7 +31,7 @@ TEST(Labels, NamesRoundTripAndLegendListsEveryClass) {
         const auto c = static_cast<SemanticClass>(i);
         EXPECT_EQ(ClassFromName(ClassName(c)), c);
     }
-    EXPECT_THROW((void)ClassFromName("spaceship"), std::invalid_argument);
+    EXPECT_THROW((void)ClassFromName("spaceship"), InvalidArgumentError);
     const auto legend = nlohmann::json::parse(LegendJson());
     ASSERT_EQ(legend.size(), static_cast<size_t>(kNumClasses));
     EXPECT_EQ(legend[4]["name"], "vehicle");

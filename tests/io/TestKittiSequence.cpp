@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ReaderTestFiles.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
 
@@ -92,7 +93,7 @@ TEST(KittiSequence, ReadsScansWithCalibratedPosesTimesAndLabels) {
     EXPECT_TRUE(scan.T_world_sensor.isApprox(seq.T_world_sensor[2]));
     EXPECT_EQ(scan.time_s, seq.times_s[2]);
     EXPECT_EQ(scan.source, seq.scan_files[2].string());
-    EXPECT_THROW(static_cast<void>(ReadKittiScan(seq, 3)), std::invalid_argument);
+    EXPECT_THROW(static_cast<void>(ReadKittiScan(seq, 3)), InvalidArgumentError);
 }
 
 TEST(KittiSequence, UsesFrameNumbersAndDefaultsWithoutCalibOrTimes) {

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "ExportTestMap.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/OctomapExport.hpp"
 
 namespace strata::io {
@@ -137,8 +138,8 @@ TEST(OctomapExport, RefusesMapsBeyondTheKeyRange) {
 
 TEST(OctomapExport, RejectsOtherExtensions) {
     const ScratchDir dir("octomap_ext");
-    EXPECT_THROW(WriteOctomap(MakeExportTestMap(), dir / "map.vdb"), std::invalid_argument);
-    EXPECT_THROW(WriteOctomap(MakeExportTestMap(), dir / "map"), std::invalid_argument);
+    EXPECT_THROW(WriteOctomap(MakeExportTestMap(), dir / "map.vdb"), InvalidArgumentError);
+    EXPECT_THROW(WriteOctomap(MakeExportTestMap(), dir / "map"), InvalidArgumentError);
     EXPECT_EQ(dir.EntryCount(), 0);
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "ExportTestMap.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PlyExport.hpp"
 
 namespace strata::io {
@@ -123,7 +124,7 @@ TEST(PlyExport, EmptyMapWritesAValidEmptyCloud) {
 
 TEST(PlyExport, UninitialisedMapIsRejected) {
     const ScratchDir dir("ply_uninitialised");
-    EXPECT_THROW(WritePly(core::VoxelMap{}, dir / "map.ply"), std::invalid_argument);
+    EXPECT_THROW(WritePly(core::VoxelMap{}, dir / "map.ply"), InvalidArgumentError);
     EXPECT_EQ(dir.EntryCount(), 0);
 }
 

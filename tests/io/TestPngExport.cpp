@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ExportTestMap.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PngExport.hpp"
 
 namespace strata::io {
@@ -144,7 +145,7 @@ TEST(PngExport, EmptyMapGivesOneUnknownCell) {
 TEST(PngExport, BadOptionsAndMissingDirectoryThrow) {
     const ScratchDir dir("png_errors");
     const core::VoxelMap map = MakeExportTestMap();
-    EXPECT_THROW((void)RenderTopDown(map, NoScaleBar(0)), std::invalid_argument);
+    EXPECT_THROW((void)RenderTopDown(map, NoScaleBar(0)), InvalidArgumentError);
     const fs::path path = dir / "missing/top.png";
     ExpectErrorNaming(path, [&] { WriteTopDownPng(map, path); });
     EXPECT_EQ(dir.EntryCount(), 0);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ReaderTestFiles.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PoseFiles.hpp"
 
 namespace strata::io {
@@ -133,9 +134,9 @@ TEST(MatchPoses, PicksTheNearestTimestampWithinTolerance) {
     } catch (const std::runtime_error& e) {
         EXPECT_NE(std::string(e.what()).find("scan 2"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(static_cast<void>(MatchPoses(poses, {0.0}, -1.0)), std::invalid_argument);
+    EXPECT_THROW(static_cast<void>(MatchPoses(poses, {0.0}, -1.0)), InvalidArgumentError);
     const std::vector<StampedPose> mixed = {{0.0, kPoses[0]}, {std::nan(""), kPoses[1]}};
-    EXPECT_THROW(static_cast<void>(MatchPoses(mixed, {0.0})), std::invalid_argument);
+    EXPECT_THROW(static_cast<void>(MatchPoses(mixed, {0.0})), InvalidArgumentError);
     EXPECT_TRUE(MatchPoses(poses, {}).empty());
 }
 

@@ -10,6 +10,7 @@
 #include <functional>
 #include <sstream>
 
+#include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/registration/Floors.hpp"
@@ -21,16 +22,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Issue #8: stacked floors within 0.05 m in x and y, 0.2 deg in yaw, z error rate <= 0.01;
-// localization RMSE <= 0.05 m.
-constexpr double kStackXyTolM = 0.05;
-constexpr double kStackYawTolDeg = 0.2;
-constexpr double kMaxZErrorRate = 0.01;
+// Issue #8's targets are 0.05 m in x and y, 0.2 deg in yaw, z error rate 0.01, localization
+// RMSE 0.05 m; the bounds below are 2-3x what these tests measure (docs/registration.md), all
+// inside the targets. Measured at most: x 0.023 m, y 0.004 m, yaw 0.017 deg, z 1.2 mm over
+// 3.5 m (rate 0.00034), localization RMSE 0.018 m.
+constexpr double kStackXTolM = 0.05;
+constexpr double kStackYTolM = 0.01;
+constexpr double kStackYawTolDeg = 0.05;
+constexpr double kMaxZErrorRate = 0.001;
 constexpr double kLocalizationRmseM = 0.05;
 constexpr double kFloorHeightM = 3.5;  // building.json, building_stairwell.json
 // z-biases off by -150 mm, 0 and +150 mm (4.3 % of the storey height, within the +-0.6 m search).
 constexpr double kZBiasesM[] = {3.35, 3.5, 3.65};
-constexpr int kScansPerFloor = 40;     // the whole corridor (12 scans see 8 m of it)
+constexpr int kScansPerFloor = 40;  // the whole corridor (12 scans see 8 m of it)
 constexpr double kVoxel = 0.1;
 
 struct Building {
@@ -121,8 +125,8 @@ TEST(RegistrationFloors, StacksTheCorridorOnlyBuildingInXyYawButRefusesToGuessZ)
         const Eigen::Isometry3d truth = T_map_world * b.spec.sessions[k].T_world_session;
         const Eigen::Vector3d dt = r.result.T_map_source.translation() - truth.translation();
         const double dyaw = YawDeg(truth.inverse() * r.result.T_map_source);
-        EXPECT_LT(std::abs(dt.x()), kStackXyTolM) << "floor " << k;
-        EXPECT_LT(std::abs(dt.y()), kStackXyTolM) << "floor " << k;
+        EXPECT_LT(std::abs(dt.x()), kStackXTolM) << "floor " << k;
+        EXPECT_LT(std::abs(dt.y()), kStackYTolM) << "floor " << k;
         EXPECT_LT(std::abs(dyaw), kStackYawTolDeg) << "floor " << k << [&] {
             std::ostringstream os;
             for (const RegistrationResult& c : r.candidates) {
@@ -163,8 +167,8 @@ TEST(RegistrationFloors, MeasuresZThroughTheStairwellFromAWrongZBias) {
         ASSERT_TRUE(r.height.measured);
         const Eigen::Vector3d dt = r.result.T_map_source.translation() - truth.translation();
         const double dyaw = YawDeg(truth.inverse() * r.result.T_map_source);
-        EXPECT_LT(std::abs(dt.x()), kStackXyTolM) << "z-bias " << z_bias;
-        EXPECT_LT(std::abs(dt.y()), kStackXyTolM) << "z-bias " << z_bias;
+        EXPECT_LT(std::abs(dt.x()), kStackXTolM) << "z-bias " << z_bias;
+        EXPECT_LT(std::abs(dt.y()), kStackYTolM) << "z-bias " << z_bias;
         EXPECT_LT(std::abs(dyaw), kStackYawTolDeg) << "z-bias " << z_bias;
         EXPECT_LE(std::abs(dt.z()) / kFloorHeightM, kMaxZErrorRate)
             << "z-bias " << z_bias << ": z " << r.height.z_m << ", " << r.height.matches
@@ -231,9 +235,7 @@ TEST(RegistrationFloors, LocalizesEveryScanOfAFloorInItsSlice) {
     FloorSlice slice;  // the storey, its floor and ceiling included, nothing of the others
     slice.l1_m = -0.2;
     slice.l2_m = 3.1;
-    RegistrationConfig config;
-    config.surface.level_cells_m = {1.0, 0.5, 0.25};
-    config.max_source_points = 1500;
+    RegistrationConfig config = LocalizationRegistration();
     config.min_source_range_m = 0.5;
     const Surface surface =
         Surface::FromPoints(OccupiedPoints(map, slice.Box(z_floor)), config.surface);
@@ -265,20 +267,20 @@ TEST(RegistrationFloors, SliceAndConfigChecks) {
     FloorSlice slice;
     slice.l1_m = 2.0;
     slice.l2_m = 1.0;
-    EXPECT_THROW(slice.Validate(), std::invalid_argument);
+    EXPECT_THROW(slice.Validate(), InvalidArgumentError);
     const Eigen::AlignedBox3d box = FloorSlice{}.Box(3.5);
     EXPECT_TRUE(box.contains(Eigen::Vector3d(100, -50, 4.0)));
     EXPECT_FALSE(box.contains(Eigen::Vector3d(0, 0, 3.6)));
     FloorStackConfig config;
     config.yaw_step_deg = 0.0;
-    EXPECT_THROW(config.Validate(), std::invalid_argument);
-    EXPECT_THROW((void)StackFloor({}, 0.0, {}, FloorStackConfig{}), std::invalid_argument);
+    EXPECT_THROW(config.Validate(), InvalidArgumentError);
+    EXPECT_THROW((void)StackFloor({}, 0.0, {}, FloorStackConfig{}), InvalidArgumentError);
     FloorHeightConfig height;
     height.inlier_m = 0.0;
-    EXPECT_THROW(height.Validate(), std::invalid_argument);
+    EXPECT_THROW(height.Validate(), InvalidArgumentError);
     height = FloorHeightConfig{};
     height.slab_band_m = height.search_m;
-    EXPECT_THROW(height.Validate(), std::invalid_argument);
+    EXPECT_THROW(height.Validate(), InvalidArgumentError);
 }
 
 }  // namespace

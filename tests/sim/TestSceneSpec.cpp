@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "SimTestUtil.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/KittiIds.hpp"
 #include "strata/sim/SceneSpec.hpp"
 
@@ -155,7 +156,7 @@ TEST(SceneSpecFuzzFindings, RefusesAWindowGridTooLargeToFill) {
     try {
         (void)ParseSceneSpec(input, "huge_wall.json");
         ADD_FAILURE() << "no error for a wall of 1e120 m with windows";
-    } catch (const std::invalid_argument& e) {
+    } catch (const FormatError& e) {
         const std::string what = e.what();
         EXPECT_NE(what.find("huge_wall.json"), std::string::npos) << what;
         EXPECT_NE(what.find("window grid"), std::string::npos) << what;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "strata/core/Error.hpp"
 #include "strata/sim/SensorModel.hpp"
 
 namespace strata::sim {
@@ -44,16 +45,16 @@ TEST(SensorModel, ColumnsSweepOnceClockwiseFromBehind) {
 }
 
 TEST(SensorModel, RejectsUnknownNamesAndNonsense) {
-    EXPECT_THROW((void)SensorModel::FromName("hdl32"), std::invalid_argument);
+    EXPECT_THROW((void)SensorModel::FromName("hdl32"), InvalidArgumentError);
     SensorModel s = SensorModel::FromName("vlp16");
     s.max_range_m = 0.1;
-    EXPECT_THROW(s.Validate(), std::invalid_argument);
+    EXPECT_THROW(s.Validate(), InvalidArgumentError);
     s = SensorModel::FromName("vlp16");
     s.dropout_probability = 1.0;
-    EXPECT_THROW(s.Validate(), std::invalid_argument);
+    EXPECT_THROW(s.Validate(), InvalidArgumentError);
     s = SensorModel::FromName("vlp16");
     s.elevation_deg.clear();
-    EXPECT_THROW(s.Validate(), std::invalid_argument);
+    EXPECT_THROW(s.Validate(), InvalidArgumentError);
 }
 
 }  // namespace strata::sim

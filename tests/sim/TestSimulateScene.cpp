@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "TempPath.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/KittiIds.hpp"
 #include "strata/sim/SensorModel.hpp"
 #include "strata/sim/SimulateScene.hpp"
@@ -140,10 +141,10 @@ TEST(SimulateScene, StaticSurfaceKeepsTheGroundUnderVehiclesAndDropsTheVehicles)
 TEST(SimulateScene, ConfigIsValidated) {
     SimulateConfig c;
     c.sensor = "hdl32";
-    EXPECT_THROW(c.Validate(), std::invalid_argument);
+    EXPECT_THROW(c.Validate(), InvalidArgumentError);
     c = SimulateConfig{};
     c.range_noise_m = -1.0;
-    EXPECT_THROW(c.Validate(), std::invalid_argument);
+    EXPECT_THROW(c.Validate(), InvalidArgumentError);
     EXPECT_THROW((void)SimulateSceneToSequence(ScenePath("missing"), TempDir("x")),
                  std::runtime_error);
 }

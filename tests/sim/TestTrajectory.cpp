@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "SimTestUtil.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/Simulator.hpp"
 #include "strata/sim/Trajectory.hpp"
 
@@ -18,7 +19,7 @@ TEST(Trajectory, MovesAtConstantSpeedAndTurnsSmoothly) {
     EXPECT_NEAR(std::atan2(corner.linear()(1, 0), corner.linear()(0, 0)), M_PI / 4, 1e-9);
     const Eigen::Isometry3d end = path.PoseAt(100.0);  // clamped
     EXPECT_TRUE(end.translation().isApprox(Eigen::Vector3d(10, 10, 1)));
-    EXPECT_THROW(Trajectory({}, 1.0), std::invalid_argument);
+    EXPECT_THROW(Trajectory({}, 1.0), InvalidArgumentError);
 }
 
 TEST(Trajectory, ScanPosesStandAboveTheGroundAtTheSensorRate) {
@@ -40,7 +41,7 @@ TEST(Trajectory, ScanPosesStandAboveTheGroundAtTheSensorRate) {
             k + 1 < 4 ? 1.0 : 0.0, 1e-9);
     }
     spec.waypoints = {{40, 40, std::nan("")}};
-    EXPECT_THROW((void)PlanScanPoses(spec, simulator, 10.0), std::invalid_argument);
+    EXPECT_THROW((void)PlanScanPoses(spec, simulator, 10.0), InvalidArgumentError);
 }
 
 }  // namespace strata::sim

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/vehicles/VehicleStages.hpp"
 
@@ -69,7 +70,7 @@ TEST(LShapeFit, RecoversTheHeadingAndSidesOfAKnownL) {
     EXPECT_NEAR(r.length, 4.5, kSideToleranceM);
     EXPECT_NEAR(r.width, 1.8, kSideToleranceM);
     EXPECT_LT((r.center - (corner + 2.25 * a + 0.9 * b)).norm(), kSideToleranceM);
-    EXPECT_THROW((void)FitLShape({Eigen::Vector2d::Zero()}), std::invalid_argument);
+    EXPECT_THROW((void)FitLShape({Eigen::Vector2d::Zero()}), InvalidArgumentError);
 }
 
 TEST(LShapeFit, BirdsEyeIoUOfKnownRectangles) {

@@ -6,6 +6,7 @@
 #include <random>
 #include <set>
 
+#include "strata/core/Error.hpp"
 #include "strata/walls/Clustering.hpp"
 #include "strata/walls/PlaneFit.hpp"
 #include "strata/walls/WallReport.hpp"
@@ -75,7 +76,7 @@ TEST(Dbscan, FindsTwoBlocksAndLeavesIsolatedVoxelsAsNoise) {
     EXPECT_NE(*a.begin(), kNoise);
     EXPECT_EQ(label[41], kNoise);
     EXPECT_EQ(label[42], kNoise);
-    EXPECT_THROW((void)Dbscan(voxels, 0.5, 4), std::invalid_argument);
+    EXPECT_THROW((void)Dbscan(voxels, 0.5, 4), InvalidArgumentError);
 }
 
 TEST(KMeans, SeparatesThreeBlobsAndFollowsTheStudysRule) {
@@ -242,10 +243,10 @@ TEST(FindWalls, RejectsABadConfig) {
     const core::VoxelMap map = core::VoxelMap::Create(0.2);
     WallConfig c;
     c.window_m = 0.0;
-    EXPECT_THROW((void)FindWalls(map, c), std::invalid_argument);
+    EXPECT_THROW((void)FindWalls(map, c), InvalidArgumentError);
     c = {};
     c.kmeans_divisor = 0;
-    EXPECT_THROW((void)FindWalls(map, c), std::invalid_argument);
+    EXPECT_THROW((void)FindWalls(map, c), InvalidArgumentError);
     EXPECT_TRUE(FindWalls(map).walls.empty());  // an empty map has no walls, and no error
 }
 

@@ -3,9 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
-#include <stdexcept>
 
 #include "Progress.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/registration/MapRegion.hpp"
 #include "strata/registration/SessionCloud.hpp"
 
@@ -43,13 +43,13 @@ void AddAlignOptions(CLI::App& cmd, AlignArgs& args, bool ranges) {
 Eigen::Isometry3d InitialGuess(const AlignArgs& args) {
     if (args.init.empty()) return Eigen::Isometry3d::Identity();
     for (double v : args.init) {
-        if (!std::isfinite(v)) throw std::invalid_argument("--init: values must be finite");
+        if (!std::isfinite(v)) throw InvalidArgumentError("--init: values must be finite");
     }
     return registration::PoseFromXyzYaw(args.init[0], args.init[1], args.init[2], args.init[3]);
 }
 
 SourceCloud ReadSourceCloud(const ScanSource& source, bool as_is, const AlignArgs& args) {
-    if (source.size() == 0) throw std::invalid_argument("no scans to align");
+    if (source.size() == 0) throw InvalidArgumentError("no scans to align");
     registration::SessionCloudConfig cloud_config;
     cloud_config.min_range_m = args.min_range_m;
     cloud_config.max_range_m = args.max_range_m;
@@ -82,8 +82,8 @@ MapAlignment AlignToMap(const store::MapStore& map, const store::Snapshot& snaps
         config.max_source_range_m = args.max_range_m;
     }
     config.Validate();
-    if (!(args.margin_m >= 0.0)) throw std::invalid_argument("--margin must be >= 0");
-    if (cloud.points.empty()) throw std::invalid_argument("the scans to align hold no points");
+    if (!(args.margin_m >= 0.0)) throw InvalidArgumentError("--margin must be >= 0");
+    if (cloud.points.empty()) throw InvalidArgumentError("the scans to align hold no points");
 
     Eigen::AlignedBox3d box = registration::BoundsOf(cloud.points, guess, args.margin_m);
     MapAlignment a;
@@ -97,9 +97,9 @@ MapAlignment AlignToMap(const store::MapStore& map, const store::Snapshot& snaps
     const registration::Surface surface = registration::Surface::FromPoints(points, config.surface);
     a.surface_ms = MsSince(start);
     if (surface.empty()) {
-        throw std::runtime_error("alignment refused: the map has no surface near the guess (" +
-                                 std::to_string(points.size()) +
-                                 " occupied voxels in range): check --init");
+        throw RefusedError("alignment refused: the map has no surface near the guess (" +
+                           std::to_string(points.size()) +
+                           " occupied voxels in range): check --init");
     }
     a.result = registration::RegisterPoints(surface, cloud.points, guess, config);
     a.total_ms = MsSince(start);
@@ -151,7 +151,7 @@ void PrintAlignment(const MapAlignment& a, std::ostream& out) {
 
 void RequireAccepted(const MapAlignment& a, const std::string& what) {
     if (!a.result.converged) {
-        throw std::runtime_error(what + " refused: " + a.result.refusal);
+        throw RefusedError(what + " refused: " + a.result.refusal);
     }
 }
 

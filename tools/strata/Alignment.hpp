@@ -58,7 +58,7 @@ struct MapAlignment {
 [[nodiscard]] nlohmann::json AlignmentJson(const MapAlignment& a);
 /// A human summary of the same.
 void PrintAlignment(const MapAlignment& a, std::ostream& out);
-/// Throws std::runtime_error with the refusal when the alignment was not accepted.
+/// Throws RefusedError with the refusal when the alignment was not accepted.
 void RequireAccepted(const MapAlignment& a, const std::string& what);
 
 }  // namespace strata::tools

@@ -6,11 +6,11 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 
 #include "Alignment.hpp"
 #include "Commands.hpp"
 #include "MapAccess.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 #include "strata/registration/MapRegion.hpp"
@@ -57,8 +57,8 @@ void RunStack(const StackArgs& args) {
     std::vector<store::FloorRecord> floors = map.Floors();
     for (const store::FloorRecord& f : floors) {
         if (f.session == session) {
-            throw std::invalid_argument("session " + std::to_string(session) + " is floor " +
-                                        std::to_string(f.index) + " already");
+            throw InvalidArgumentError("session " + std::to_string(session) + " is floor " +
+                                       std::to_string(f.index) + " already");
         }
     }
     // No floor yet: the oldest other session is the ground floor, in the map frame.
@@ -71,8 +71,8 @@ void RunStack(const StackArgs& args) {
             }
         }
         if (base.session == 0) {
-            throw std::invalid_argument(args.map + " has no other session to stack session " +
-                                        std::to_string(session) + " on");
+            throw InvalidArgumentError(args.map + " has no other session to stack session " +
+                                       std::to_string(session) + " on");
         }
         floors.push_back(base);
     }
@@ -157,9 +157,9 @@ void RunLocalize(const LocalizeArgs& args) {
         return f.index == args.floor;
     });
     if (it == floors.end()) {
-        throw std::invalid_argument("--floor " + std::to_string(args.floor) + ": " + args.map +
-                                    " has " + std::to_string(floors.size()) +
-                                    " floors recorded (strata stack records them)");
+        throw InvalidArgumentError("--floor " + std::to_string(args.floor) + ": " + args.map +
+                                   " has " + std::to_string(floors.size()) +
+                                   " floors recorded (strata stack records them)");
     }
     // The slice of the stacked map: every storey moved into the map frame, then cut.
     const store::Snapshot snapshot = map.Latest();
@@ -171,15 +171,12 @@ void RunLocalize(const LocalizeArgs& args) {
             if (box.contains(p)) slice.push_back(p);
         }
     }
-    reg::RegistrationConfig config = args.align.config;
-    config.surface.level_cells_m = {1.0, 0.5, 0.25};
-    config.max_source_points = 1500;
+    reg::RegistrationConfig config = args.align.config;  // LocalizationRegistration + options
     config.min_source_range_m = args.align.min_range_m;
     config.max_source_range_m = args.align.max_range_m;
     const reg::Surface surface = reg::Surface::FromPoints(slice, config.surface);
     if (surface.empty())
-        throw std::runtime_error("floor " + std::to_string(args.floor) +
-                                 " has no surface in its slice");
+        throw RefusedError("floor " + std::to_string(args.floor) + " has no surface in its slice");
     const core::Scan scan = ReadScan(args.scan);
     const Eigen::Isometry3d guess =
         args.align.init.empty() ? Eigen::Isometry3d(it->T_map_floor) : InitialGuess(args.align);
@@ -242,6 +239,7 @@ void RegisterFloors(CLI::App& app) {
         ->capture_default_str();
     lcmd->add_flag("--json", loc->json, "Print the result as JSON");
     loc->align.min_range_m = 0.5;
+    loc->align.config = reg::LocalizationRegistration();
     AddAlignOptions(*lcmd, loc->align);
     lcmd->callback([loc] { RunLocalize(*loc); });
 }

@@ -5,6 +5,7 @@
 #include "Alignment.hpp"
 #include "Commands.hpp"
 #include "MapAccess.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::tools {
 
@@ -24,7 +25,7 @@ struct RegisterArgs {
 
 void Run(const RegisterArgs& args) {
     if (args.kitti.empty() == args.scans.empty()) {
-        throw std::invalid_argument("give exactly one of --kitti SEQ or --scans FILES...");
+        throw InvalidArgumentError("give exactly one of --kitti SEQ or --scans FILES...");
     }
     const store::MapStore map = OpenMap(args.map);
     io::ReadOptions read_options;

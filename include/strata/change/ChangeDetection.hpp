@@ -102,7 +102,7 @@ struct ChangeSet {
 /// voxels near a surface of the other side (`surface_tolerance_voxels`) and on the rim of what it
 /// observed (`observed_margin_voxels`); a voxel unobserved by either side is unknown, never
 /// changed. Changed voxels are grouped into objects.
-/// @throws std::invalid_argument when a mask is missing or `voxel_size` is not positive.
+/// @throws InvalidArgumentError when a mask is missing or `voxel_size` is not positive.
 [[nodiscard]] ChangeSet DetectChanges(const Observation& a, const Observation& b, double voxel_size,
                                       const ChangeQuery& query = {});
 

@@ -22,7 +22,7 @@ struct ReportContext {
 [[nodiscard]] std::string ChangeReportJson(const ChangeSet& changes, const ReportContext& context);
 
 /// @brief Writes the `added` and `removed` grids (BoolGrids, with `units` and `origin` metadata)
-/// to a .vdb file, all or nothing; throws std::runtime_error naming `path` on failure.
+/// to a .vdb file, all or nothing; throws IoError naming `path` on failure.
 void WriteChangeVdb(const ChangeSet& changes, const ReportContext& context,
                     const std::filesystem::path& path);
 

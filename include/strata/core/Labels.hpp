@@ -30,7 +30,7 @@ struct Rgb {
 [[nodiscard]] const char* ClassName(SemanticClass c);
 /// @brief Display colour of a class (used by PNG, PLY, OctoMap and VDB colour exports).
 [[nodiscard]] Rgb ClassColor(SemanticClass c);
-/// @brief Parses a class name as printed by ClassName; throws std::invalid_argument otherwise.
+/// @brief Parses a class name as printed by ClassName; throws InvalidArgumentError otherwise.
 [[nodiscard]] SemanticClass ClassFromName(const std::string& name);
 /// @brief The legend as a JSON array [{"id":..,"name":..,"color":[r,g,b]}], stored in grid metadata.
 [[nodiscard]] std::string LegendJson();

@@ -13,13 +13,13 @@ namespace strata::core {
 /// inside it.
 class Region {
 public:
-    /// @brief The box [x0, x1] x [y0, y1]; throws std::invalid_argument unless x0 < x1, y0 < y1
+    /// @brief The box [x0, x1] x [y0, y1]; throws InvalidArgumentError unless x0 < x1, y0 < y1
     /// and all are finite.
     [[nodiscard]] static Region Box(double x0, double y0, double x1, double y1);
     /// @brief A polygon of at least three finite vertices, in either winding order.
     [[nodiscard]] static Region Polygon(std::vector<Eigen::Vector2d> vertices);
     /// @brief Parses "x0,y0,x1,y1" (a box) or "x0,y0,x1,y1,x2,y2,..." (a polygon of three or more
-    /// vertices); throws std::invalid_argument naming the text when it is neither.
+    /// vertices); throws InvalidArgumentError naming the text when it is neither.
     [[nodiscard]] static Region Parse(const std::string& text);
 
     [[nodiscard]] const std::vector<Eigen::Vector2d>& vertices() const { return vertices_; }

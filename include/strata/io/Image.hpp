@@ -14,7 +14,7 @@ namespace strata::io {
 class RgbImage {
 public:
     RgbImage() = default;
-    /// @brief A width x height image filled with `fill`; throws std::invalid_argument unless both
+    /// @brief A width x height image filled with `fill`; throws InvalidArgumentError unless both
     /// sizes are positive.
     RgbImage(int width, int height, core::Rgb fill = {0, 0, 0});
 
@@ -56,12 +56,12 @@ void DrawLabel(RgbImage& image, int x, int y, const std::string& text, int scale
 [[nodiscard]] int LabelWidth(const std::string& text, int scale = 2);
 
 /// @brief Writes an 8-bit RGB PNG, all or nothing (temporary file + rename).
-/// @note Throws std::runtime_error naming `path` on any I/O problem, std::invalid_argument for an
+/// @note Throws IoError naming `path` on any I/O problem, InvalidArgumentError for an
 /// empty image.
 void WritePng(const RgbImage& image, const std::filesystem::path& path);
 
 /// @brief Reads a PNG of any colour type as 8-bit RGB (alpha dropped, grey expanded); throws
-/// std::runtime_error naming `path` when it cannot be read or decoded.
+/// NotFoundError/IoError naming `path` when it cannot be read, FormatError when it cannot be decoded.
 [[nodiscard]] RgbImage ReadPng(const std::filesystem::path& path);
 
 }  // namespace strata::io

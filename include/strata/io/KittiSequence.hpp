@@ -25,15 +25,15 @@ struct KittiSequence {
 /// @note A scan named NNNNNN.bin takes line NNNNNN of poses.txt and times.txt (frame numbers),
 /// so a folder holding frames 100-199 pairs with the full poses.txt; other names take their
 /// position in sorted order. `Tr` comes from calib.txt, identity when calib.txt is absent.
-/// @throws std::runtime_error naming the file or folder: no velodyne/ or no scans in it, no
-/// poses.txt, fewer poses (or times) than needed (the message gives both counts), a non-finite
-/// pose, calib.txt without `Tr:`, or a labels/ folder that lacks a scan's .label file.
+/// @throws NotFoundError naming the file or folder: no velodyne/ or no scans in it, no
+/// poses.txt, a labels/ folder that lacks a scan's .label file; FormatError: fewer poses (or times) than needed (the message gives both counts), a non-finite
+/// pose, calib.txt without `Tr:`,.
 [[nodiscard]] KittiSequence OpenKittiSequence(const std::filesystem::path& dir);
 
 /// @brief Loads scan `index`: points and intensity, labels and instances when the sequence has
 /// labels (SemanticKITTI ids mapped with LabelMapping::SemanticKitti()), pose, time and source.
 /// All points are kept, so they stay one-to-one with the .label file.
-/// @throws std::invalid_argument when index >= seq.size(); std::runtime_error naming the file
+/// @throws InvalidArgumentError when index >= seq.size(); IoError/FormatError naming the file
 /// when a file is unreadable or the label count differs from the point count.
 [[nodiscard]] core::Scan ReadKittiScan(const KittiSequence& seq, size_t index);
 
@@ -43,19 +43,19 @@ struct KittiPoints {
     std::vector<float> intensity;
 };
 
-/// @brief Reads a KITTI .bin scan; throws std::runtime_error naming the file when its size is
-/// not a multiple of 16 bytes or it cannot be read.
+/// @brief Reads a KITTI .bin scan; throws FormatError naming the file when its size is
+/// not a multiple of 16 bytes, NotFoundError/IoError when it cannot be read.
 [[nodiscard]] KittiPoints ReadKittiBin(const std::filesystem::path& path);
 
 /// @brief Reads a SemanticKITTI .label file (N x uint32: low 16 bits class, high 16 instance).
 [[nodiscard]] std::vector<uint32_t> ReadKittiLabels(const std::filesystem::path& path);
 
 /// @brief Writes a KITTI .bin scan (points rounded to float32). `intensity` is empty (written as
-/// 0) or one per point, else std::invalid_argument. Throws std::runtime_error on write failure.
+/// 0) or one per point, else InvalidArgumentError. Throws IoError on write failure.
 void WriteKittiBin(const std::filesystem::path& path, const std::vector<Eigen::Vector3d>& points,
                    const std::vector<float>& intensity = {});
 
-/// @brief Writes a SemanticKITTI .label file; throws std::runtime_error on write failure.
+/// @brief Writes a SemanticKITTI .label file; throws IoError on write failure.
 void WriteKittiLabels(const std::filesystem::path& path, const std::vector<uint32_t>& labels);
 
 }  // namespace strata::io

@@ -12,7 +12,7 @@ namespace strata::io {
 /// Coordinates are world coordinates, map centre + `map.origin`: written as `float` when the
 /// origin is zero (map frame = world frame), as `double` otherwise, because float32 at UTM scale is
 /// off by about 0.5 m. Header comments give the voxel size and the origin.
-/// @note Throws std::runtime_error naming `path` on I/O failure and leaves no file behind
+/// @note Throws IoError naming `path` on I/O failure and leaves no file behind
 /// (temporary file + rename). Two sequential passes over the active voxels (count, then write);
 /// memory use is a fixed-size buffer.
 void WritePly(const core::VoxelMap& map, const std::filesystem::path& path);

@@ -35,13 +35,13 @@ struct TopDownImage {
 /// gets the colour of the class of its highest occupied voxel (or a height ramp), brightened with
 /// height so that structure shows; observed columns with no occupied voxel get `free_color`,
 /// unobserved ones `unknown_color`. An empty map gives a single unknown cell.
-/// @note Throws std::invalid_argument for pixels_per_voxel < 1 or max_size_px < 1. Visits the
+/// @note Throws InvalidArgumentError for pixels_per_voxel < 1 or max_size_px < 1. Visits the
 /// active voxels in parallel (TBB, one label accessor per task); memory is 8 bytes per column
 /// plus the picture.
 [[nodiscard]] TopDownImage RenderTopDown(const core::VoxelMap& map,
                                          const TopDownOptions& options = {});
 
-/// @brief RenderTopDown written as an RGB PNG (temporary file + rename; std::runtime_error naming
+/// @brief RenderTopDown written as an RGB PNG (temporary file + rename; IoError naming
 /// `path` on I/O failure, nothing left behind).
 void WriteTopDownPng(const core::VoxelMap& map, const std::filesystem::path& path,
                      const TopDownOptions& options = {});

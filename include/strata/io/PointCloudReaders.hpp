@@ -29,8 +29,9 @@ struct ReadOptions {
 /// organised clouds use for missing returns).
 /// @note Raw label ids follow SemanticKITTI's packing: the low 16 bits are the class (mapped to
 /// `labels`), the high 16 bits the instance (`instances` is filled only when one is non-zero).
-/// @throws std::invalid_argument for an unknown extension; std::runtime_error naming the file for
-/// .laz (with a hint to decompress it) and any unreadable, truncated or inconsistent file.
+/// @throws InvalidArgumentError for an unknown extension; NotFoundError/IoError naming the file
+/// when it cannot be read; FormatError naming it for .laz (with a hint to decompress it) and any
+/// truncated or inconsistent file.
 [[nodiscard]] core::Scan ReadPointCloud(const std::filesystem::path& path,
                                         const ReadOptions& options = {});
 
@@ -80,7 +81,7 @@ struct LasHeader {
 };
 
 /// @brief Reads and checks a LAS header (signature, sizes, point format) without reading points.
-/// @throws std::runtime_error naming the file when the header is invalid or disagrees with the
+/// @throws FormatError naming the file when the header is invalid or disagrees with the
 /// file size. A compressed (LAZ) header is returned with `compressed` set, not refused.
 [[nodiscard]] LasHeader ReadLasHeader(const std::filesystem::path& path);
 

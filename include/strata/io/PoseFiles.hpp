@@ -15,7 +15,7 @@ struct StampedPose {
 
 /// @brief Reads a KITTI pose file: one pose per line, 12 numbers = row-major 3x4 [R|t].
 /// Blank lines are ignored.
-/// @throws std::runtime_error naming the file and line for a wrong number of values, a
+/// @throws FormatError naming the file and line for a wrong number of values, a
 /// non-finite value or a rotation block that is not a rotation.
 [[nodiscard]] std::vector<Eigen::Isometry3d> ReadKittiPoses(const std::filesystem::path& path);
 
@@ -24,7 +24,7 @@ struct StampedPose {
 [[nodiscard]] std::vector<StampedPose> ReadTumPoses(const std::filesystem::path& path);
 
 /// @brief Reads `Tr:` (12 numbers, velodyne -> camera) from a KITTI calib.txt.
-/// @throws std::runtime_error naming the file when the line is missing or malformed.
+/// @throws FormatError naming the file when the line is missing or malformed.
 [[nodiscard]] Eigen::Isometry3d ReadKittiCalibTr(const std::filesystem::path& calib_txt);
 
 /// @brief Reads a pose file of either format, detected from the values on the first data line
@@ -36,15 +36,15 @@ struct StampedPose {
 
 /// @brief The pose of each scan: by index when the poses have no timestamps (KITTI), otherwise
 /// the pose with the nearest timestamp, which must be within `max_dt_s`.
-/// @throws std::runtime_error naming the first scan (index and time) that has no pose;
-/// std::invalid_argument when max_dt_s < 0 or only some poses have timestamps.
+/// @throws FormatError naming the first scan (index and time) that has no pose;
+/// InvalidArgumentError when max_dt_s < 0 or only some poses have timestamps.
 /// @note O((n + m) log m) for n scans and m poses.
 [[nodiscard]] std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
                                                         const std::vector<double>& scan_times_s,
                                                         double max_dt_s = 0.05);
 
 /// @brief Writes poses in KITTI format (12 values per line, full double precision).
-/// @throws std::runtime_error naming the file on write failure.
+/// @throws IoError naming the file on write failure.
 void WriteKittiPoses(const std::filesystem::path& path,
                      const std::vector<Eigen::Isometry3d>& poses);
 

@@ -26,7 +26,7 @@ inline constexpr const char* kColor = "color";
 /// class legend (`class_legend`, JSON); the file metadata repeats producer, origin, voxel size and
 /// legend.
 /// @note The file is written to a temporary sibling and renamed into place: a failed export
-/// (missing directory, full disk) throws std::runtime_error naming `path` and leaves no file.
+/// (missing directory, full disk) throws IoError naming `path` and leaves no file.
 /// Adds `producer`/`origin` metadata to the map's grids (as VoxelMap::Grids does).
 /// Threading: the viewer grids are built in parallel (TBB), one accessor per task.
 void WriteVdb(const core::VoxelMap& map, const std::filesystem::path& path,
@@ -34,7 +34,7 @@ void WriteVdb(const core::VoxelMap& map, const std::filesystem::path& path,
 
 /// @brief Writes `grids` and the file metadata `file_meta` to a .vdb file, all or nothing (as
 /// WriteVdb): for analysis products (change masks, slant grids) that are not a whole map.
-/// @note Throws std::runtime_error naming `path` when the file cannot be written.
+/// @note Throws IoError naming `path` when the file cannot be written.
 void WriteGrids(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& file_meta,
                 const std::filesystem::path& path);
 

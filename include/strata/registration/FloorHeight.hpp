@@ -21,7 +21,7 @@ struct FloorHeightConfig {
     /// the best one's matches makes the height ambiguous: refused.
     double max_second_ratio = 0.6;
 
-    /// @brief Throws std::invalid_argument naming the field when a value is out of range.
+    /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
     void Validate() const;
 };
 

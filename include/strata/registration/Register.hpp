@@ -31,7 +31,7 @@ struct RegistrationResult {
 /// @brief Aligns source points (source frame, metres) to `target`, starting from
 /// `T_map_source_init`: point-to-plane ICP with a Cauchy loss, one stage per level of `target`,
 /// correspondences in parallel (TBB). Never throws for a bad alignment: it is refused in the
-/// result. Throws std::invalid_argument on an invalid config or an empty target.
+/// result. Throws InvalidArgumentError on an invalid config or an empty target.
 [[nodiscard]] RegistrationResult RegisterPoints(const Surface& target,
                                                 const std::vector<Eigen::Vector3d>& source,
                                                 const Eigen::Isometry3d& T_map_source_init,

@@ -16,7 +16,7 @@ struct SurfaceConfig {
     /// At least this many fine points around a cell to fit its normal.
     int min_neighbours = 4;
 
-    /// @brief Throws std::invalid_argument naming the field when a value is out of range.
+    /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
     void Validate() const;
 };
 
@@ -32,9 +32,12 @@ struct RegistrationConfig {
     /// and pull the estimate towards no motion.
     double min_source_range_m = 0.0;
     double max_source_range_m = 0.0;
-    /// At most this many source points per level (evenly strided after thinning): ICP accuracy
-    /// saturates long before, and time grows with it.
+    /// At most this many source points per coarse level (evenly strided after thinning): those
+    /// levels only bring the estimate into the finest level's basin.
     int max_source_points = 6000;
+    /// At most this many at the finest level, whose sampling noise stays in the result: 6000
+    /// points leave 0.02-0.04 deg of it on real scans (docs/registration.md, "Real scans").
+    int max_finest_source_points = 20000;
     /// ICP iterations (correspondences + one Ceres solve) per level.
     int max_iterations_per_level = 40;
     /// Ceres iterations per ICP iteration.
@@ -57,7 +60,7 @@ struct RegistrationConfig {
     /// vertical offset comes from the floor height).
     bool planar = false;
 
-    /// @brief Throws std::invalid_argument naming the field when a value is out of range.
+    /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
     void Validate() const;
 };
 

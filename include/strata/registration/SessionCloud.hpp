@@ -15,7 +15,7 @@ struct SessionCloudConfig {
     double min_range_m = 1.0;   ///< the vehicle and the operator are not the map
     double max_range_m = 60.0;  ///< far returns are sparse and noisy
 
-    /// @brief Throws std::invalid_argument naming the field when a value is out of range.
+    /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
     void Validate() const;
 };
 
@@ -23,7 +23,7 @@ struct SessionCloudConfig {
 /// cell. Scans are added one at a time, so a long session need not be held in memory.
 class CloudAccumulator {
 public:
-    /// @throw std::invalid_argument on an invalid config.
+    /// @throw InvalidArgumentError on an invalid config.
     explicit CloudAccumulator(const SessionCloudConfig& config = {});
     /// @brief Adds `scan.points` moved by `scan.T_world_sensor`; non-finite points are skipped.
     void Add(const core::Scan& scan);

@@ -28,7 +28,7 @@ struct Surface {
     std::vector<SurfaceLevel> levels;
 
     /// @brief Builds the levels from points (map frame, metres). Empty input gives empty levels.
-    /// Throws std::invalid_argument on an invalid config.
+    /// Throws InvalidArgumentError on an invalid config.
     [[nodiscard]] static Surface FromPoints(const std::vector<Eigen::Vector3d>& points,
                                             const SurfaceConfig& config);
     [[nodiscard]] bool empty() const { return levels.empty() || levels.back().points.empty(); }

@@ -74,7 +74,7 @@ struct GroundTruth {
 };
 
 /// @brief Writes ground_truth.json (keys in docs/simulator.md), coordinates in the session frame.
-/// Throws std::runtime_error naming the file when it cannot be written.
+/// Throws IoError naming the file when it cannot be written.
 void WriteGroundTruth(const std::filesystem::path& path, const GroundTruth& truth);
 
 }  // namespace strata::sim

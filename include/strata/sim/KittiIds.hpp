@@ -30,7 +30,7 @@ inline constexpr uint16_t kTrafficSign = 81;
 inline constexpr uint16_t kOtherObject = 99;
 
 /// @brief Raw id of a SemanticKITTI class name ("car", "road", "other-structure", ...) or of a
-/// decimal id given as text ("44"); throws std::invalid_argument for anything else.
+/// decimal id given as text ("44"); throws InvalidArgumentError for anything else.
 [[nodiscard]] uint16_t IdFromName(const std::string& name);
 /// @brief SemanticKITTI name of a raw id ("car"); "unknown" for ids the simulator never writes.
 [[nodiscard]] const char* Name(uint16_t id);

@@ -40,7 +40,7 @@ struct Scene {
 
 /// @brief Builds the meshes and ground truth of one session of a scene (edits of sessions
 /// 0..session applied). Deterministic: the same spec gives the same triangles.
-/// @note Throws std::invalid_argument for a session index out of range.
+/// @note Throws InvalidArgumentError for a session index out of range.
 [[nodiscard]] Scene BuildScene(const SceneSpec& spec, size_t session);
 
 }  // namespace strata::sim

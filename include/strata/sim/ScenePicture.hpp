@@ -21,7 +21,7 @@ struct PictureConfig {
     bool draw_trajectory = true;  ///< scan positions as red dots
     bool draw_edits = true;       ///< edit boxes: added green, removed red
 
-    /// @brief Throws std::invalid_argument for a non-positive pixel size, margin < 0 or
+    /// @brief Throws InvalidArgumentError for a non-positive pixel size, margin < 0 or
     /// max_size_px < 16.
     void Validate() const;
 };
@@ -39,7 +39,7 @@ struct Picture {
                                          const std::vector<ScanPose>& poses,
                                          const PictureConfig& config = {});
 
-/// @brief Writes an RGB PNG (io::WritePng); throws std::runtime_error naming the file on failure.
+/// @brief Writes an RGB PNG (io::WritePng); throws IoError naming the file on failure.
 void WritePicturePng(const std::filesystem::path& path, const Picture& picture);
 
 }  // namespace strata::sim

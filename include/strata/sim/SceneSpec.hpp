@@ -62,15 +62,15 @@ struct SceneSpec {
     std::vector<double> floor_z;        ///< building scenes: z offset of each storey
     std::vector<GapSpec> gaps;
 
-    /// @brief Throws std::invalid_argument (naming `source`) on duplicate ids or names, an edit
+    /// @brief Throws FormatError (naming `source`) on duplicate ids or names, an edit
     /// of an unknown object, or a session without waypoints.
     void Validate() const;
-    /// @brief Index of the object with this name; throws std::invalid_argument if there is none.
+    /// @brief Index of the object with this name; throws FormatError if there is none.
     [[nodiscard]] size_t IndexOf(const std::string& object_name) const;
 };
 
-/// @brief Reads a scene file (JSON, docs/simulator.md). Throws std::runtime_error when the file
-/// cannot be read or parsed, std::invalid_argument (naming the file and key) for bad content.
+/// @brief Reads a scene file (JSON, docs/simulator.md). Throws NotFoundError/IoError when the file
+/// cannot be read, FormatError (naming the file and, for bad content, the key) otherwise.
 [[nodiscard]] SceneSpec LoadSceneSpec(const std::filesystem::path& path);
 /// @brief Parses scene JSON text; `source` names it in error messages.
 [[nodiscard]] SceneSpec ParseSceneSpec(const std::string& json_text,

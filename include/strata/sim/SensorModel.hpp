@@ -23,7 +23,7 @@ struct SensorModel {
     double intensity_noise = 0.02;      ///< standard deviation added to the intensity
 
     /// @brief Sensors by name: "hdl64" (Velodyne HDL-64E, KITTI), "vlp16" (Velodyne VLP-16),
-    /// "os1-64" and "os1-128" (Ouster OS1 gen2). Throws std::invalid_argument otherwise.
+    /// "os1-64" and "os1-128" (Ouster OS1 gen2). Throws InvalidArgumentError otherwise.
     [[nodiscard]] static SensorModel FromName(const std::string& name);
     /// @brief Names accepted by FromName.
     [[nodiscard]] static std::vector<std::string> Names();
@@ -35,7 +35,7 @@ struct SensorModel {
     [[nodiscard]] double ColumnAzimuthRad(int column) const;
     /// @brief Seconds from the start of the sweep to the firing of a column.
     [[nodiscard]] double ColumnTimeS(int column) const;
-    /// @brief Throws std::invalid_argument for an empty beam table or out-of-range values.
+    /// @brief Throws InvalidArgumentError for an empty beam table or out-of-range values.
     void Validate() const;
 };
 

@@ -12,7 +12,7 @@ namespace strata::sim {
 /// velodyne/NNNNNN.bin (float32 x y z intensity, sensor frame), labels/NNNNNN.label (uint32:
 /// class | instance << 16), and on Finish poses.txt (3x4 row-major T_session_sensor per line),
 /// times.txt and calib.txt (identity Tr, synthetic P0..P3). Little-endian, as KITTI.
-/// @note Throws std::runtime_error naming the file on any write failure.
+/// @note Throws IoError naming the file on any write failure.
 class SequenceWriter {
 public:
     /// @brief Creates `dir`, `dir/velodyne` and `dir/labels`.

@@ -24,7 +24,7 @@ struct SimulateConfig {
     bool write_picture = true;            ///< picture.png (top-down, by class) in each sequence
     PictureConfig picture;
 
-    /// @brief Throws std::invalid_argument for an unknown sensor or out-of-range values.
+    /// @brief Throws InvalidArgumentError for an unknown sensor or out-of-range values.
     void Validate() const;
 };
 
@@ -47,7 +47,7 @@ using SimulateProgress = std::function<void(size_t, size_t)>;
 
 /// @brief Simulates every session of a scene into SemanticKITTI sequences with ground truth:
 /// `out_dir` itself for a one-session scene, else `out_dir/session_<k>` for each session.
-/// @note Throws std::invalid_argument for a bad config or scene, std::runtime_error naming the
+/// @note Throws InvalidArgumentError for a bad config, FormatError for a bad scene, IoError naming the
 /// file on I/O failure. Uses all TBB threads; limit them in the caller.
 [[nodiscard]] SimulateReport SimulateSceneToSequence(const SceneSpec& scene,
                                                      const std::filesystem::path& out_dir,

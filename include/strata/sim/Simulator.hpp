@@ -50,7 +50,7 @@ struct SimulatedScan {
 /// constructor; all const methods are thread-safe and may run concurrently.
 class Simulator {
 public:
-    /// @brief Copies the meshes into an Embree scene; throws std::runtime_error if Embree fails.
+    /// @brief Copies the meshes into an Embree scene; throws strata::Error if Embree fails.
     explicit Simulator(const Scene& scene);
     ~Simulator();
     Simulator(Simulator&&) noexcept;

@@ -21,7 +21,7 @@ struct SurfaceSample {
 };
 
 /// @brief Samples every static mesh uniformly by area, about one point per spacing_m^2.
-/// Deterministic for a seed. Throws std::invalid_argument unless spacing_m > 0.
+/// Deterministic for a seed. Throws InvalidArgumentError unless spacing_m > 0.
 [[nodiscard]] SurfaceSample SampleStaticSurface(const Scene& scene, double spacing_m,
                                                 uint64_t seed);
 
@@ -34,7 +34,7 @@ void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
                   double min_elevation_deg = -90.0, double max_elevation_deg = 90.0);
 
 /// @brief Writes a binary little-endian PLY (x y z float, label instance ushort, observed
-/// uchar), points mapped by T_out_world. Throws std::runtime_error naming the file on failure.
+/// uchar), points mapped by T_out_world. Throws IoError naming the file on failure.
 void WriteSurfacePly(const std::filesystem::path& path, const SurfaceSample& sample,
                      const Eigen::Isometry3d& T_out_world = Eigen::Isometry3d::Identity());
 

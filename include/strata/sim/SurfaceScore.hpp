@@ -25,7 +25,7 @@ struct SurfaceScore {
 /// `reference_points` sampled on the part of the surface the map should hold (for example
 /// SampleStaticSurface points that MarkObserved flagged). Distances beyond `max_distance_m`
 /// count as `max_distance_m`. Parallel (TBB).
-/// @throw std::invalid_argument for no points or a threshold <= 0.
+/// @throw InvalidArgumentError for no points or a threshold <= 0.
 [[nodiscard]] SurfaceScore ScoreSurface(const std::vector<Eigen::Vector3d>& map_points,
                                         const Scene& scene,
                                         const std::vector<Eigen::Vector3d>& reference_points,

@@ -20,7 +20,7 @@ struct ScanPose {
 /// and faces along the path; near a corner the heading turns smoothly over `turn_blend_m`.
 class Trajectory {
 public:
-    /// @brief Throws std::invalid_argument for no positions or a speed <= 0.
+    /// @brief Throws InvalidArgumentError for no positions or a speed <= 0.
     Trajectory(std::vector<Eigen::Vector3d> positions_world, double speed_mps,
                double turn_blend_m = 2.0);
 
@@ -42,7 +42,7 @@ private:
 
 /// @brief Scan poses of a session: waypoint floors resolved with downward rays where their z is
 /// NaN, the sensor `height_m` above them, one pose every `every` sweeps at the sensor rate,
-/// until the path ends or `max_scans` poses. Throws std::invalid_argument when no ground is
+/// until the path ends or `max_scans` poses. Throws InvalidArgumentError when no ground is
 /// found under a waypoint.
 [[nodiscard]] std::vector<ScanPose> PlanScanPoses(const TrajectorySpec& trajectory,
                                                   const Simulator& simulator, double rate_hz);

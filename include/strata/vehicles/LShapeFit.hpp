@@ -31,7 +31,7 @@ struct OrientedRect {
 /// the points are assigned to the nearer of the two closest rectangle edges and the heading
 /// minimising the summed variance of those distances wins. Length is the longer side; yaw_rad
 /// is in [-pi/2, pi/2).
-/// @throw std::invalid_argument for fewer than 2 points or a step outside (0, 45] degrees.
+/// @throw InvalidArgumentError for fewer than 2 points or a step outside (0, 45] degrees.
 [[nodiscard]] OrientedRect FitLShape(const std::vector<Eigen::Vector2d>& points,
                                      double step_deg = 1.0);
 

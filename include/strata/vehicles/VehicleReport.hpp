@@ -20,7 +20,7 @@ namespace strata::vehicles {
 
 /// @brief A top-down picture, before (left) and after (right): columns by height below
 /// `max_z_m` (a garage's ceiling left out), every vehicle box outlined in yellow, refilled
-/// cells in cyan on the right. Throws std::runtime_error naming `path`.
+/// cells in cyan on the right. Throws IoError naming `path`.
 void WriteVehiclesPng(const core::VoxelMap& before, const core::VoxelMap& after,
                       const VehicleResult& result, const std::filesystem::path& path,
                       double max_z_m);

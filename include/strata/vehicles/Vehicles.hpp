@@ -20,7 +20,7 @@ inline constexpr const char* kRefilled = "vehicle_refilled";  ///< FloatGrid: gr
 
 enum class VehicleSource { kAuto, kLabel, kGeometric };
 [[nodiscard]] const char* SourceName(VehicleSource source);  ///< "auto", "label", "geometric"
-/// @throw std::invalid_argument for any other name.
+/// @throw InvalidArgumentError for any other name.
 [[nodiscard]] VehicleSource SourceFromName(const std::string& name);
 
 /// @brief Options of the vehicle pipeline (docs/vehicles.md). Lengths in metres.
@@ -103,7 +103,7 @@ struct VehicleResult {
 /// "Vehicles and ground refill"): vehicle voxels from labels or the geometric detector,
 /// objects, L-shape boxes, clearing, ground refill from the ring around each box, Embree ray
 /// checks from the sensor origins (map frame) so that a cell seen empty stays empty.
-/// @throw std::invalid_argument for a map without grids or a bad config.
+/// @throw InvalidArgumentError for a map without grids or a bad config.
 [[nodiscard]] VehicleResult ClearVehicles(core::VoxelMap& map,
                                           const std::vector<Eigen::Vector3d>& origins_map,
                                           const VehicleConfig& config = {});

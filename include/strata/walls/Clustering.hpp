@@ -16,7 +16,7 @@ inline constexpr int kNoise = -1;
 /// in voxel units). A voxel with at least `min_points` neighbours (itself included) is a core
 /// voxel; clusters are core voxels linked through each other plus the border voxels they reach.
 /// @return one label per voxel: 0, 1, ... in order of first appearance, or kNoise.
-/// @throw std::invalid_argument unless eps_voxels >= 1 and min_points >= 1.
+/// @throw InvalidArgumentError unless eps_voxels >= 1 and min_points >= 1.
 [[nodiscard]] std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
                                       int min_points);
 

@@ -31,7 +31,7 @@ struct PlaneFit {
 /// @brief Total least squares (eigen-decomposition of the covariance of the centred points): the
 /// normal is the direction of least variance. `weights` (one per point, >= 0; empty = all 1)
 /// weigh each point, e.g. by the number of endpoints a voxel mean stands for; `points` of the
-/// result is then the weight sum. Throws std::invalid_argument for fewer than 3 points.
+/// result is then the weight sum. Throws InvalidArgumentError for fewer than 3 points.
 [[nodiscard]] PlaneFit FitPlane(const std::vector<Eigen::Vector3d>& points,
                                 const std::vector<double>& weights = {});
 
@@ -44,7 +44,7 @@ struct RansacResult {
 
 /// @brief RANSAC plane: `iterations` minimal samples (3 points, seeded), the plane with the most
 /// points within `threshold` wins, then is refitted to its inliers and the inliers recounted.
-/// Throws std::invalid_argument for fewer than 3 points or a non-positive threshold.
+/// Throws InvalidArgumentError for fewer than 3 points or a non-positive threshold.
 [[nodiscard]] RansacResult RansacPlane(const std::vector<Eigen::Vector3d>& points, double threshold,
                                        int iterations = 200, uint64_t seed = 1);
 

@@ -39,7 +39,7 @@ inline constexpr const char* kWallId = "wall_id";      ///< Int32Grid: id of the
 /// @brief A top-down slant map: the map's occupied columns in grey (darker = more occupied
 /// voxels), wall voxels coloured by SlantColor, a legend (degrees) and a scale bar. Pixels are
 /// the voxel size, or coarser so the image stays within `max_pixels` on a side. Written all or
-/// nothing; throws std::runtime_error naming `path` on failure.
+/// nothing; throws IoError naming `path` on failure.
 void WriteWallsPng(const core::VoxelMap& map, const WallResult& result,
                    const std::filesystem::path& path, int max_pixels = 3000);
 

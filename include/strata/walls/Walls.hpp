@@ -61,7 +61,7 @@ struct WallConfig {
     /// (for comparison: docs/walls.md shows what each choice costs).
     bool use_point_means = true;
 
-    /// @brief Throws std::invalid_argument naming the first bad field.
+    /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;
 };
 
@@ -154,7 +154,7 @@ struct WallResult {
 
 /// @brief The whole pipeline on a map (ARCHITECTURE.md, "Walls and slant angles"): column
 /// statistics, voting, DBSCAN, K-means, RANSAC + wall tests per part, merge, SVD + Ceres per
-/// wall. Uses one thread. Throws std::invalid_argument for a bad config or a map without
+/// wall. Uses one thread. Throws InvalidArgumentError for a bad config or a map without
 /// occupancy.
 [[nodiscard]] WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config = {});
 
