@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::core {
@@ -29,13 +30,13 @@ typename GridT::Ptr FindGrid(const openvdb::GridPtrVec& grids, const char* name)
         if (g && g->getName() == name) {
             auto typed = openvdb::gridPtrCast<GridT>(g);
             if (!typed) {
-                throw std::runtime_error(std::string("grid '") + name + "' has type " + g->type() +
+                throw FormatError(std::string("grid '") + name + "' has type " + g->type() +
                                          ", expected " + GridT::gridType());
             }
             return typed;
         }
     }
-    throw std::runtime_error(std::string("the map has no '") + name + "' grid");
+    throw FormatError(std::string("the map has no '") + name + "' grid");
 }
 
 bool HasGrid(const openvdb::GridPtrVec& grids, const char* name) {
@@ -98,10 +99,10 @@ openvdb::math::Transform::Ptr VoxelMap::MakeTransform(double voxel_size_m) {
 
 VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
     if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m)) {
-        throw std::invalid_argument("voxel size must be positive, got " +
+        throw InvalidArgumentError("voxel size must be positive, got " +
                                     std::to_string(voxel_size_m));
     }
-    if (!origin.allFinite()) throw std::invalid_argument("map origin must be finite");
+    if (!origin.allFinite()) throw InvalidArgumentError("map origin must be finite");
     openvdb::initialize();
     VoxelMap map;
     map.voxel_size = voxel_size_m;
@@ -168,13 +169,13 @@ VoxelMap VoxelMap::FromGrids(const openvdb::GridPtrVec& grids) {
     map.label_weight = FindGrid<openvdb::FloatGrid>(grids, grid_names::kLabelWeight);
     const openvdb::Vec3d vs = map.occupancy->voxelSize();
     if (!(vs[0] > 0.0) || vs[0] != vs[1] || vs[0] != vs[2]) {
-        throw std::runtime_error("the occupancy grid does not have cubic voxels");
+        throw FormatError("the occupancy grid does not have cubic voxels");
     }
     map.voxel_size = vs[0];
     const auto expected = MakeTransform(map.voxel_size);
     const auto require_aligned = [&](const openvdb::GridBase& g) {
         if (g.transform() != *expected) {
-            throw std::runtime_error("grid '" + g.getName() + "' is not aligned with 'occupancy'");
+            throw FormatError("grid '" + g.getName() + "' is not aligned with 'occupancy'");
         }
     };
     for (const auto& g : {openvdb::GridBase::Ptr(map.label), openvdb::GridBase::Ptr(map.label_weight)}) {

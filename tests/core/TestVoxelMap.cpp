@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include "strata/core/Error.hpp"
+
 namespace strata::core {
 namespace {
 
@@ -117,11 +119,11 @@ TEST(VoxelMap, MapsWrittenBeforePackedEndpointsReadBack) {
 }
 
 TEST(VoxelMap, RejectsBadVoxelSizeAndMissingGrids) {
-    EXPECT_THROW((void)VoxelMap::Create(0.0), std::invalid_argument);
-    EXPECT_THROW((void)VoxelMap::Create(-1.0), std::invalid_argument);
+    EXPECT_THROW((void)VoxelMap::Create(0.0), InvalidArgumentError);
+    EXPECT_THROW((void)VoxelMap::Create(-1.0), InvalidArgumentError);
     const VoxelMap map = VoxelMap::Create(0.1);
     openvdb::GridPtrVec partial{map.occupancy};
-    EXPECT_THROW((void)VoxelMap::FromGrids(partial), std::runtime_error);
+    EXPECT_THROW((void)VoxelMap::FromGrids(partial), FormatError);
 }
 
 }  // namespace

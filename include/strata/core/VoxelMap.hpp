@@ -36,7 +36,7 @@ struct VoxelMap {
     /// not limited by the voxel size (NDT maps keep the same).
     openvdb::Int32Grid::Ptr endpoints;
 
-    /// @brief An empty map; throws std::invalid_argument unless 0 < voxel_size_m.
+    /// @brief An empty map; throws InvalidArgumentError unless 0 < voxel_size_m.
     [[nodiscard]] static VoxelMap Create(double voxel_size_m,
                                          const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
     /// @brief A copy that shares no tree with this map.
@@ -49,7 +49,7 @@ struct VoxelMap {
     /// (Int32Grid, points) and `point_mean` (Vec3SGrid, metres from the voxel centre).
     [[nodiscard]] openvdb::GridPtrVec ExportGrids() const;
     /// @brief Rebuilds a map from Grids() (or from a file with `hits` and `point_mean` instead of
-    /// `endpoints`, as maps were written before); throws std::runtime_error when a grid is missing
+    /// `endpoints`, as maps were written before); throws FormatError when a grid is missing
     /// or has the wrong type or transform.
     [[nodiscard]] static VoxelMap FromGrids(const openvdb::GridPtrVec& grids);
     /// @brief Whether a grid of this name is one of a map's own (not a product or a layer).
