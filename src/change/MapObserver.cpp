@@ -1,9 +1,9 @@
 #include "strata/change/MapObserver.hpp"
 #include "strata/core/Error.hpp"
 
-#include <tbb/parallel_for.h>
+#include <algorithm>
 
-#include <stdexcept>
+#include "strata/core/Error.hpp"
 
 namespace strata::change {
 namespace {
@@ -34,59 +34,54 @@ void AddLabels(Observation& o, const core::VoxelMap& fused) {
 
 }  // namespace
 
-MapObserver::MapObserver(const store::MapStore& store, std::optional<core::Region> region)
-    : store_(store), region_(std::move(region)) {}
+MapObserver::MapObserver(const store::MapStore& store, std::optional<core::Region> region,
+                         size_t memory_budget_bytes)
+    : store_(store),
+      region_(std::move(region)),
+      reader_(store, store::Snapshot{}, memory_budget_bytes) {}
 
-std::vector<std::shared_ptr<const store::Tile>> MapObserver::Tiles(
-    const store::Snapshot& snapshot) {
-    const store::MapSettings& settings = store_.settings();
-    std::vector<const store::TileVersion*> wanted;
-    for (const store::TileVersion& v : snapshot.tiles) {
-        if (region_) {
-            const openvdb::CoordBBox box = settings.TileBounds(v.key);
-            const Eigen::Vector2d lo(box.min().x() * settings.voxel_size_m,
-                                     box.min().y() * settings.voxel_size_m);
-            const Eigen::Vector2d hi((box.max().x() + 1) * settings.voxel_size_m,
-                                     (box.max().y() + 1) * settings.voxel_size_m);
-            if (!region_->MayOverlap(lo, hi)) continue;
-        }
-        wanted.push_back(&v);
-    }
-    std::vector<const store::TileVersion*> missing;
-    for (const store::TileVersion* v : wanted) {
-        if (!cache_.count(v->file)) missing.push_back(v);
-    }
-    std::vector<std::shared_ptr<const store::Tile>> read(missing.size());
-    tbb::parallel_for(size_t{0}, missing.size(), [&](size_t i) {
-        read[i] = std::make_shared<const store::Tile>(store_.ReadTile(*missing[i]));
-    });
-    for (size_t i = 0; i < missing.size(); ++i) cache_[missing[i]->file] = read[i];
-    std::vector<std::shared_ptr<const store::Tile>> tiles;
-    for (const store::TileVersion* v : wanted) tiles.push_back(cache_.at(v->file));
-    return tiles;
+std::vector<store::TileKey> MapObserver::Keys(const store::TileReader& reader) const {
+    return region_ ? reader.Tiles(region_->min(), region_->max(), 0) : reader.Tiles();
 }
 
 Observation MapObserver::Session(int64_t session_id) {
-    const store::Snapshot snapshot = store_.AsOf(session_id);
+    int64_t commit = 0;
+    for (const auto& [session, removed] : store_.SessionHistory()) {
+        if (session.id == session_id) commit = session.commit;
+    }
+    if (commit == 0) {
+        throw NotFoundError(store_.dir().string() + ": no session " + std::to_string(session_id));
+    }
+    // Its layers are what it saw, whatever came later; the labels are the map's right after it
+    // (or as close after as the kept history allows).
+    const store::TileReader reader = reader_.At(store_.At(std::max(commit, store_.HistoryStart())));
+    const auto& alive = reader.snapshot().sessions;
+    if (std::none_of(alive.begin(), alive.end(),
+                     [&](const store::SessionRecord& s) { return s.id == session_id; })) {
+        throw NotFoundError(store_.dir().string() + ": session " + std::to_string(session_id) +
+                            " was removed and gc dropped its layers");
+    }
     Observation o = EmptyObservation(*store_.EmptyMap().occupancy->transformPtr());
-    for (const auto& tile : Tiles(snapshot)) {
-        for (const store::SessionLayer& layer : tile->layers) {
-            if (layer.session != session_id) continue;
-            AddPiece(*o.masks.occupied, *layer.occupied);
-            AddPiece(*o.masks.free, *layer.free);
+    for (const store::TileKey& key : Keys(reader)) {
+        if (const auto layer = reader.Layers(key, session_id)) {
+            AddPiece(*o.masks.occupied, *layer->occupied);
+            AddPiece(*o.masks.free, *layer->free);
         }
-        AddLabels(o, tile->fused);
+        if (const auto fused = reader.Fused(key)) AddLabels(o, *fused);
     }
     return o;
 }
 
 Observation MapObserver::Map(const store::Snapshot& snapshot) {
+    const store::TileReader reader = reader_.At(snapshot);
     Observation o = EmptyObservation(*store_.EmptyMap().occupancy->transformPtr());
-    for (const auto& tile : Tiles(snapshot)) {
-        const core::OccupancyMasks masks = core::SplitOccupancy(*tile->fused.occupancy);
+    for (const store::TileKey& key : Keys(reader)) {
+        const auto tile = reader.Fused(key);
+        if (!tile) continue;  // layers only: the snapshot's fused map is empty there
+        const core::OccupancyMasks masks = core::SplitOccupancy(*tile->occupancy);
         o.masks.occupied->tree().merge(masks.occupied->tree(), openvdb::MERGE_ACTIVE_STATES);
         o.masks.free->tree().merge(masks.free->tree(), openvdb::MERGE_ACTIVE_STATES);
-        AddLabels(o, tile->fused);
+        AddLabels(o, *tile);
     }
     return o;
 }

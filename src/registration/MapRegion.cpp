@@ -3,35 +3,28 @@
 #include <tbb/parallel_for.h>
 
 #include "strata/registration/Surface.hpp"
+#include "strata/store/TileReader.hpp"
 
 namespace strata::registration {
 
 core::VoxelMap LoadMapRegion(const store::MapStore& map, const store::Snapshot& snapshot,
                              const Eigen::AlignedBox3d& box) {
-    const store::MapSettings& settings = map.settings();
-    const double s = settings.voxel_size_m;
-    store::Snapshot in_range = snapshot;
-    in_range.tiles.clear();
-    for (const store::TileVersion& tile : snapshot.tiles) {
-        const openvdb::CoordBBox b = settings.TileBounds(tile.key);
-        const bool overlaps =
-            b.min().x() * s <= box.max().x() && (b.max().x() + 1) * s >= box.min().x() &&
-            b.min().y() * s <= box.max().y() && (b.max().y() + 1) * s >= box.min().y();
-        if (overlaps) in_range.tiles.push_back(tile);
-    }
-    return map.LoadMap(in_range);
+    // One pass over the region's fused tiles: nothing is kept once they are merged.
+    const store::TileReader reader(map, snapshot, 0);
+    return reader.LoadFused(
+        reader.Tiles(box.min().head<2>(), box.max().head<2>(), /*halo_voxels=*/0));
 }
 
 std::vector<Eigen::Vector3d> SessionPoints(const store::MapStore& map,
                                            const store::Snapshot& snapshot, int64_t session) {
-    std::vector<std::vector<Eigen::Vector3d>> per_tile(snapshot.tiles.size());
-    tbb::parallel_for(size_t{0}, snapshot.tiles.size(), [&](size_t i) {
-        const store::Tile tile = map.ReadTile(snapshot.tiles[i]);
-        for (const store::SessionLayer& layer : tile.layers) {
-            if (layer.session == session && layer.occupied) {
-                per_tile[i] = MaskedPoints(tile.fused, *layer.occupied);
-            }
-        }
+    // Only the tiles the session saw, and of them its layers and the fused point means.
+    const store::TileReader reader(map, snapshot, 0);
+    const std::vector<store::TileKey> keys = reader.SessionTiles(session);
+    std::vector<std::vector<Eigen::Vector3d>> per_tile(keys.size());
+    tbb::parallel_for(size_t{0}, keys.size(), [&](size_t i) {
+        const auto layer = reader.Layers(keys[i], session);
+        const auto fused = reader.Fused(keys[i]);
+        if (layer && fused) per_tile[i] = MaskedPoints(*fused, *layer->occupied);
     });
     std::vector<Eigen::Vector3d> points;
     for (const auto& v : per_tile) points.insert(points.end(), v.begin(), v.end());

@@ -1,5 +1,8 @@
 #include "Catalog.hpp"
 
+#include "IntegrationRule.hpp"
+#include "strata/core/Error.hpp"
+
 #include <cinttypes>
 #include <cstdio>
 #include <ctime>
@@ -8,165 +11,6 @@
 
 namespace strata::store::detail {
 namespace {
-
-// Migration k takes a catalog from version k to k + 1. Never edit a released step: add one.
-constexpr const char* kMigrations[] = {
-    // 0 -> 1: the first schema.
-    R"sql(
-CREATE TABLE settings (
-  key   TEXT PRIMARY KEY,
-  value TEXT NOT NULL
-);
-CREATE TABLE commits (
-  id         INTEGER PRIMARY KEY AUTOINCREMENT,
-  time_utc   TEXT NOT NULL,
-  session_id INTEGER,
-  kind       TEXT NOT NULL CHECK (kind IN ('create', 'integrate', 'remove_session'))
-);
-CREATE TABLE sessions (
-  id                INTEGER PRIMARY KEY AUTOINCREMENT,
-  name              TEXT NOT NULL,
-  source            TEXT NOT NULL DEFAULT '',
-  sensor            TEXT NOT NULL DEFAULT '',
-  start_utc         TEXT NOT NULL,
-  end_utc           TEXT NOT NULL,
-  scan_count        INTEGER NOT NULL,
-  point_count       INTEGER NOT NULL,
-  alignment         TEXT NOT NULL,
-  notes             TEXT NOT NULL DEFAULT '',
-  commit_id         INTEGER NOT NULL REFERENCES commits(id),
-  removed_commit_id INTEGER REFERENCES commits(id)
-);
-CREATE TABLE scans (
-  session_id  INTEGER NOT NULL REFERENCES sessions(id),
-  idx         INTEGER NOT NULL,
-  time_s      REAL NOT NULL,
-  pose        TEXT NOT NULL,
-  point_count INTEGER NOT NULL,
-  source_file TEXT NOT NULL DEFAULT '',
-  PRIMARY KEY (session_id, idx)
-);
-CREATE TABLE tiles (
-  x INTEGER NOT NULL,
-  y INTEGER NOT NULL,
-  PRIMARY KEY (x, y)
-);
-CREATE TABLE tile_versions (
-  x         INTEGER NOT NULL,
-  y         INTEGER NOT NULL,
-  version   INTEGER NOT NULL,
-  file      TEXT,
-  byte_size INTEGER NOT NULL,
-  checksum  TEXT NOT NULL,
-  commit_id INTEGER NOT NULL REFERENCES commits(id),
-  PRIMARY KEY (x, y, version),
-  FOREIGN KEY (x, y) REFERENCES tiles(x, y)
-);
-CREATE INDEX tile_versions_by_commit ON tile_versions(commit_id);
-CREATE TABLE walls (
-  id         INTEGER PRIMARY KEY AUTOINCREMENT,
-  commit_id  INTEGER NOT NULL REFERENCES commits(id),
-  center_x   REAL, center_y REAL, center_z REAL,
-  normal_x   REAL, normal_y REAL, normal_z REAL,
-  slant_deg  REAL,
-  length_m   REAL,
-  height_m   REAL,
-  points     INTEGER
-);
-CREATE TABLE vehicles (
-  id          INTEGER PRIMARY KEY AUTOINCREMENT,
-  commit_id   INTEGER NOT NULL REFERENCES commits(id),
-  center_x    REAL, center_y REAL, center_z REAL,
-  length_m    REAL,
-  width_m     REAL,
-  heading_deg REAL,
-  voxels      INTEGER,
-  refilled    INTEGER
-);
-CREATE TABLE change_sets (
-  id             INTEGER PRIMARY KEY AUTOINCREMENT,
-  commit_id      INTEGER NOT NULL REFERENCES commits(id),
-  session_a      INTEGER NOT NULL,
-  session_b      INTEGER NOT NULL,
-  added_voxels   INTEGER,
-  removed_voxels INTEGER,
-  report         TEXT
-);
-)sql",
-    // 1 -> 2: change sets name their sides as text (sessions, snapshots or uncommitted scans).
-    // Version 1 never wrote the table, so it is replaced, not altered.
-    R"sql(
-DROP TABLE change_sets;
-CREATE TABLE change_sets (
-  id             INTEGER PRIMARY KEY AUTOINCREMENT,
-  commit_id      INTEGER NOT NULL REFERENCES commits(id),
-  created_utc    TEXT NOT NULL,
-  from_side      TEXT NOT NULL,
-  to_side        TEXT NOT NULL,
-  added_voxels   INTEGER NOT NULL,
-  removed_voxels INTEGER NOT NULL,
-  unknown_voxels INTEGER NOT NULL,
-  objects        INTEGER NOT NULL,
-  report         TEXT NOT NULL
-);
-)sql",
-    // 2 -> 3: analyses commit their products (kinds 'walls', 'vehicles'); the walls table gets the
-    // columns `strata walls` reports. Neither table had rows of these kinds before, so walls is
-    // replaced and commits is rebuilt with the wider CHECK (SQLite cannot alter a CHECK).
-    R"sql(
-CREATE TABLE commits_v3 (
-  id         INTEGER PRIMARY KEY AUTOINCREMENT,
-  time_utc   TEXT NOT NULL,
-  session_id INTEGER,
-  kind       TEXT NOT NULL
-             CHECK (kind IN ('create', 'integrate', 'remove_session', 'walls', 'vehicles'))
-);
-INSERT INTO commits_v3(id, time_utc, session_id, kind)
-  SELECT id, time_utc, session_id, kind FROM commits;
-DROP TABLE commits;
-ALTER TABLE commits_v3 RENAME TO commits;
-DROP TABLE walls;
-CREATE TABLE walls (
-  id               INTEGER PRIMARY KEY AUTOINCREMENT,
-  commit_id        INTEGER NOT NULL REFERENCES commits(id),
-  wall_id          INTEGER NOT NULL,
-  center_x REAL NOT NULL, center_y REAL NOT NULL, center_z REAL NOT NULL,
-  normal_x REAL NOT NULL, normal_y REAL NOT NULL, normal_z REAL NOT NULL,
-  slant_deg        REAL NOT NULL,
-  uncertainty_deg  REAL NOT NULL,
-  lean_azimuth_deg REAL NOT NULL,
-  area_m2          REAL NOT NULL,
-  rms_m            REAL NOT NULL,
-  length_m         REAL NOT NULL,
-  height_m         REAL NOT NULL,
-  inliers          INTEGER NOT NULL
-);
-CREATE INDEX walls_by_commit ON walls(commit_id);
-)sql",
-    // 3 -> 4: the vehicles table gets the columns `strata vehicles` reports. No version wrote
-    // vehicle rows before, so it is replaced.
-    R"sql(
-DROP TABLE vehicles;
-CREATE TABLE vehicles (
-  id             INTEGER PRIMARY KEY AUTOINCREMENT,
-  commit_id      INTEGER NOT NULL REFERENCES commits(id),
-  vehicle_id     INTEGER NOT NULL,
-  center_x REAL NOT NULL, center_y REAL NOT NULL, center_z REAL NOT NULL,
-  length_m       REAL NOT NULL,
-  width_m        REAL NOT NULL,
-  height_m       REAL NOT NULL,
-  yaw_deg        REAL NOT NULL,
-  source         TEXT NOT NULL CHECK (source IN ('label', 'geometric')),
-  voxels         INTEGER NOT NULL,
-  cleared_voxels INTEGER NOT NULL,
-  refilled_cells INTEGER NOT NULL,
-  refused_cells  INTEGER NOT NULL
-);
-CREATE INDEX vehicles_by_commit ON vehicles(commit_id);
-)sql",
-};
-constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
-static_assert(kMigrationCount == MapStore::kFormatVersion, "one migration per format version");
 
 std::string Join(const double* values, int n) {
     std::ostringstream os;
@@ -180,7 +24,7 @@ void Split(const std::string& text, double* values, int n, const std::string& wh
     std::istringstream is(text);
     for (int i = 0; i < n; ++i) {
         if (!(is >> values[i])) {
-            throw std::runtime_error(db.file().string() + ": damaged " + what + " '" + text + "'");
+            throw FormatError(db.file().string() + ": damaged " + what + " '" + text + "'");
         }
     }
 }
@@ -225,25 +69,6 @@ SessionRecord SessionFromRow(const Statement& row, const Database& db) {
     return s;
 }
 
-uint64_t ParseChecksum(const std::string& hex, const Database& db) {
-    uint64_t value = 0;
-    if (hex.size() != 16 || std::sscanf(hex.c_str(), "%16" SCNx64, &value) != 1) {
-        throw std::runtime_error(db.file().string() + ": damaged checksum '" + hex + "'");
-    }
-    return value;
-}
-
-TileVersion TileFromRow(const Statement& row, const Database& db) {
-    TileVersion t;
-    t.key = {static_cast<int32_t>(row.Int(0)), static_cast<int32_t>(row.Int(1))};
-    t.version = row.Int(2);
-    t.file = row.IsNull(3) ? std::string() : row.Text(3);
-    t.bytes = static_cast<uint64_t>(row.Int(4));
-    t.checksum = ParseChecksum(row.Text(5), db);
-    t.commit = row.Int(6);
-    return t;
-}
-
 }  // namespace
 
 std::string UtcNow() {
@@ -253,40 +78,6 @@ std::string UtcNow() {
     char buf[32];
     std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
     return buf;
-}
-
-std::string ChecksumHex(uint64_t checksum) {
-    char buf[17];
-    std::snprintf(buf, sizeof(buf), "%016" PRIx64, checksum);
-    return buf;
-}
-
-int CatalogVersion(const Database& db) {
-    Statement q(db, "PRAGMA user_version");
-    return q.Step() ? static_cast<int>(q.Int(0)) : 0;
-}
-
-void RequireReadableVersion(const Database& db) {
-    const int version = CatalogVersion(db);
-    if (version > MapStore::kFormatVersion) {
-        throw std::runtime_error(db.file().string() + ": map format version " +
-                                 std::to_string(version) + " is newer than this strata reads (" +
-                                 std::to_string(MapStore::kFormatVersion) +
-                                 "); use a newer strata");
-    }
-}
-
-void MigrateCatalog(const Database& db) {
-    RequireReadableVersion(db);
-    for (int version = CatalogVersion(db); version < kMigrationCount; ++version) {
-        Transaction tx(db, Transaction::Kind::kWrite);
-        db.Exec(kMigrations[version]);
-        db.Exec(("PRAGMA user_version = " + std::to_string(version + 1)).c_str());
-        Statement(db, "INSERT OR REPLACE INTO settings(key, value) VALUES ('format_version', ?)")
-            .Bind(1, std::to_string(version + 1))
-            .Run();
-        tx.Commit();
-    }
 }
 
 void WriteSettings(const Database& db, const MapSettings& s) {
@@ -303,6 +94,7 @@ void WriteSettings(const Database& db, const MapSettings& s) {
     put("origin", Join(s.origin.data(), 3));
     put("created_by", s.created_by);
     put("created_utc", s.created_utc);
+    WriteIntegrationRule(db, s.integration, /*replace=*/true);
 }
 
 MapSettings ReadSettings(const Database& db) {
@@ -312,7 +104,7 @@ MapSettings ReadSettings(const Database& db) {
     const auto get = [&](const char* key) {
         const auto it = values.find(key);
         if (it == values.end()) {
-            throw std::runtime_error(db.file().string() + ": setting '" + key + "' is missing");
+            throw FormatError(db.file().string() + ": setting '" + key + "' is missing");
         }
         return it->second;
     };
@@ -324,13 +116,29 @@ MapSettings ReadSettings(const Database& db) {
     s.voxel_size_m = voxel;
     s.tile_voxels = static_cast<int32_t>(tile);
     if (!(voxel > 0.0) || s.tile_voxels <= 0 || s.tile_voxels % 8 != 0) {
-        throw std::runtime_error(db.file().string() + ": invalid voxel or tile size");
+        throw FormatError(db.file().string() + ": invalid voxel or tile size");
     }
     Split(get("origin"), s.origin.data(), 3, "origin", db);
-    s.format_version = std::stoi(get("format_version"));
+    double format = 0.0;
+    Split(get("format_version"), &format, 1, "format version", db);
+    s.format_version = static_cast<int>(format);
     s.created_by = get("created_by");
     s.created_utc = get("created_utc");
+    if (s.format_version >= 5) s.integration = ReadIntegrationRule(values, db);
     return s;
+}
+
+int64_t HistoryStart(const Database& db) {
+    Statement q(db, "SELECT value FROM settings WHERE key = 'history_start'");
+    double commit = 0.0;
+    if (q.Step()) Split(q.Text(0), &commit, 1, "history start", db);
+    return static_cast<int64_t>(commit);
+}
+
+void SetHistoryStart(const Database& db, int64_t commit) {
+    Statement(db, "INSERT OR REPLACE INTO settings(key, value) VALUES ('history_start', ?)")
+        .Bind(1, std::to_string(commit))
+        .Run();
 }
 
 int64_t LatestCommit(const Database& db) {
@@ -428,52 +236,11 @@ std::vector<ScanRecord> ReadScans(const Database& db, int64_t session_id) {
     return out;
 }
 
-std::vector<TileVersion> ReadTiles(const Database& db, int64_t commit) {
-    Statement q(db,
-                "SELECT v.x, v.y, v.version, v.file, v.byte_size, v.checksum, v.commit_id "
-                "FROM tile_versions v JOIN (SELECT x, y, MAX(version) AS version "
-                "FROM tile_versions WHERE commit_id <= ?1 GROUP BY x, y) newest "
-                "USING (x, y, version) WHERE v.file IS NOT NULL ORDER BY v.x, v.y");
-    q.Bind(1, commit);
-    std::vector<TileVersion> out;
-    while (q.Step()) out.push_back(TileFromRow(q, db));
+std::vector<std::pair<int64_t, std::string>> CommitTimes(const Database& db) {
+    Statement q(db, "SELECT id, time_utc FROM commits ORDER BY id");
+    std::vector<std::pair<int64_t, std::string>> out;
+    while (q.Step()) out.emplace_back(q.Int(0), q.Text(1));
     return out;
-}
-
-std::vector<TileVersion> ReadAllTileVersions(const Database& db) {
-    Statement q(db,
-                "SELECT x, y, version, file, byte_size, checksum, commit_id FROM tile_versions "
-                "ORDER BY x, y, version");
-    std::vector<TileVersion> out;
-    while (q.Step()) out.push_back(TileFromRow(q, db));
-    return out;
-}
-
-std::map<TileKey, int64_t> ReadLastVersions(const Database& db) {
-    Statement q(db, "SELECT x, y, MAX(version) FROM tile_versions GROUP BY x, y");
-    std::map<TileKey, int64_t> out;
-    while (q.Step()) {
-        out[{static_cast<int32_t>(q.Int(0)), static_cast<int32_t>(q.Int(1))}] = q.Int(2);
-    }
-    return out;
-}
-
-void InsertTileVersion(const Database& db, const TileVersion& v) {
-    Statement(db, "INSERT OR IGNORE INTO tiles(x, y) VALUES (?, ?)")
-        .Bind(1, int64_t{v.key.x})
-        .Bind(2, int64_t{v.key.y})
-        .Run();
-    Statement q(db,
-                "INSERT INTO tile_versions(x, y, version, file, byte_size, checksum, commit_id) "
-                "VALUES (?,?,?,?,?,?,?)");
-    q.Bind(1, int64_t{v.key.x}).Bind(2, int64_t{v.key.y}).Bind(3, v.version);
-    if (v.file.empty()) {
-        q.BindNull(4);
-    } else {
-        q.Bind(4, v.file);
-    }
-    q.Bind(5, static_cast<int64_t>(v.bytes)).Bind(6, ChecksumHex(v.checksum)).Bind(7, v.commit);
-    q.Run();
 }
 
 }  // namespace strata::store::detail

@@ -1,5 +1,6 @@
 #pragma once
-// Private to the store: what a MapStore holds, shared by MapStore and SessionWriter.
+// Private to the store: what a MapStore holds, shared by the store's own files, SessionWriter and
+// TileReader (friends of MapStore).
 
 #include <memory>
 
@@ -16,12 +17,16 @@ struct MapStore::Impl {
     int lock_fd = -1;  ///< holds the flock on writer.lock while this process writes
 
     ~Impl();
-    /// Throws unless this store was opened for writing.
+    /// Throws InvalidArgumentError unless this store was opened for writing.
     void RequireWriter(const char* what) const;
-    /// `tiles/X_Y/vN.vdb`, relative to the map directory.
-    [[nodiscard]] std::string TileFile(const TileKey& key, int64_t version) const;
     [[nodiscard]] std::filesystem::path TileDir(const TileKey& key) const;
+    /// The snapshot at `commit` (0: the newest), read in one transaction; NotFoundError when gc
+    /// dropped it.
     [[nodiscard]] Snapshot SnapshotAt(int64_t commit) const;
+    /// The id the next commit gets (files are named after it before the transaction).
+    [[nodiscard]] int64_t NextCommitId() const;
+    /// Removes files written for a commit that did not land.
+    void RemoveFiles(const std::vector<std::string>& files) const;
 };
 
 }  // namespace strata::store

@@ -1,18 +1,22 @@
 #include "strata/store/SessionWriter.hpp"
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <chrono>
 #include <map>
 #include <openvdb/tools/Prune.h>
+#include <optional>
 #include <set>
+#include <tuple>
 
 #include "Catalog.hpp"
+#include "IntegrationRule.hpp"
 #include "MapStoreImpl.hpp"
+#include "Parallel.hpp"
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/core/OccupancyMasks.hpp"
 
 namespace strata::store {
@@ -22,36 +26,35 @@ namespace fs = std::filesystem;
 
 // A session's own log-odds over one tile -> its two layers (occupied: > 0, free: <= 0), built
 // leaf by leaf: a layer voxel is true and active, or false and inactive.
-SessionLayer ToLayer(int64_t session, const openvdb::FloatGrid& logodds) {
+openvdb::GridPtrVec LayerGrids(int64_t session, const openvdb::FloatGrid& logodds) {
     core::OccupancyMasks masks = core::SplitOccupancy(logodds);
+    masks.occupied->setName(detail::LayerName(session, true));
+    masks.free->setName(detail::LayerName(session, false));
     for (auto* grid : {masks.occupied.get(), masks.free.get()}) {
         grid->setGridClass(openvdb::GRID_UNKNOWN);
         grid->insertMeta("units", openvdb::StringMetadata("seen by session " +
                                                           std::to_string(session)));
     }
-    return SessionLayer{session, std::move(masks.occupied), std::move(masks.free)};
+    return {masks.occupied, masks.free};
 }
 
 }  // namespace
 
 struct SessionWriter::State {
-    // A tile whose fused grids are merged into `work`.
     struct Resident {
-        std::vector<SessionLayer> layers;  // earlier sessions', carried through unchanged
-        openvdb::GridPtrVec products;
-        size_t layer_bytes = 0;
         bool dirty = false;  // changed since it was loaded
         uint64_t last_use = 0;
     };
-    // A tile version this writer wrote before the commit (an eviction), and the session's own
-    // log-odds for the tile beside it, needed if a later scan touches the tile again.
+    // What an eviction wrote before the commit: the tile's pending fused version, this session's
+    // layers so far, and its own log-odds, needed if a later scan touches the tile again.
     struct Pending {
         TileVersion version;
-        TileVersion logodds;
+        LayerFile layer;
+        FileRef logodds;
     };
 
-    MapStore& store;
     MapStore::Impl& impl;
+    const MapStore& store;
     integration::IntegrationConfig config;
     SessionOptions options;
     int64_t session_id = 0;
@@ -69,19 +72,15 @@ struct SessionWriter::State {
     bool done = false;
     WriterStats stats;
 
-    State(MapStore& s, const integration::IntegrationConfig& c, SessionOptions o)
-        : store(s), impl(s.impl()), config(c), options(std::move(o)) {}
+    State(MapStore::Impl& i, const MapStore& s, const integration::IntegrationConfig& c,
+          SessionOptions o)
+        : impl(i), store(s), config(c), options(std::move(o)) {}
 
     [[nodiscard]] const MapSettings& settings() const { return impl.settings; }
 
     [[nodiscard]] int64_t NextVersion(const TileKey& key) const {
         const auto it = last_versions.find(key);
         return (it == last_versions.end() ? 0 : it->second) + 1;
-    }
-
-    [[nodiscard]] std::string LogOddsFile(const TileKey& key) const {
-        return impl.TileFile(key, NextVersion(key)) + ".session_" + std::to_string(session_id) +
-               "_logodds";
     }
 
     std::set<TileKey> TouchedTiles(const integration::ScanUpdate& update) const {
@@ -94,36 +93,27 @@ struct SessionWriter::State {
         return keys;
     }
 
-    // Reads what is needed to make `key` resident: the pending version and the session's
-    // log-odds when an eviction wrote them, else the committed version, else nothing (new tile).
+    // What makes `key` resident: the pending version and the session's log-odds when an
+    // eviction wrote them, else the committed version, else nothing (a new tile).
     struct Loaded {
         TileKey key;
-        Tile tile;
+        std::optional<core::VoxelMap> fused;
         openvdb::FloatGrid::Ptr logodds;
-        bool exists = false;
     };
 
     Loaded Read(const TileKey& key) const {
         Loaded out;
         out.key = key;
         if (const auto p = pending.find(key); p != pending.end()) {
-            out.tile = store.ReadTile(p->second.version);
-            // The pending version already carries this session's layers; the log-odds replace
-            // them while the tile is resident.
-            out.tile.layers.erase(
-                std::remove_if(out.tile.layers.begin(), out.tile.layers.end(),
-                               [&](const SessionLayer& l) { return l.session == session_id; }),
-                out.tile.layers.end());
-            const TileVersion& lv = p->second.logodds;
-            const fs::path path = impl.dir / lv.file;
+            out.fused = store.ReadFused(p->second.version);
+            const FileRef& lo = p->second.logodds;
             const auto grids = detail::DecodeGrids(
-                detail::ReadVerifiedFile(path, lv.bytes, lv.checksum), key, path);
+                detail::ReadVerifiedFile(impl.dir, lo, detail::FileKind::kLayers), key,
+                impl.dir / lo.file);
             out.logodds = grids.empty() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(grids[0]);
-            if (!out.logodds) throw std::runtime_error(path.string() + ": no session log-odds");
-            out.exists = true;
+            if (!out.logodds) throw FormatError((impl.dir / lo.file).string() + ": no log-odds");
         } else if (const auto c = committed.find(key); c != committed.end()) {
-            out.tile = store.ReadTile(c->second);
-            out.exists = true;
+            out.fused = store.ReadFused(c->second);
         }
         return out;
     }
@@ -134,64 +124,45 @@ struct SessionWriter::State {
             if (!resident.count(key)) missing.push_back(key);
         }
         std::vector<Loaded> loaded(missing.size());
-        tbb::parallel_for(size_t{0}, missing.size(),
-                          [&](size_t i) { loaded[i] = Read(missing[i]); });
+        detail::ParallelFor(missing.size(), [&](size_t i) { loaded[i] = Read(missing[i]); });
         for (Loaded& l : loaded) {
-            Resident& r = resident[l.key];
-            if (!l.exists) continue;
+            resident[l.key];
+            if (!l.fused) continue;
             ++stats.tiles_loaded;
-            detail::MergeMap(work, l.tile.fused);
+            detail::MergeMap(work, *l.fused);
             if (l.logodds) detail::MergeLeaves(*session, *l.logodds);
-            r.layers = std::move(l.tile.layers);
-            r.products = std::move(l.tile.products);
-            for (const SessionLayer& layer : r.layers) {
-                r.layer_bytes += layer.occupied->memUsage() + layer.free->memUsage();
-            }
         }
     }
 
     [[nodiscard]] size_t MemoryBytes() const {
         size_t bytes = session->memUsage();
         for (const auto& grid : work.Grids()) bytes += grid->memUsage();
-        for (const auto& [key, r] : resident) bytes += r.layer_bytes;
         return bytes;
     }
 
-    // The final form of a tile leaving memory: fused grids, earlier layers, this session's.
-    Tile Assemble(const TileKey& key, core::VoxelMap fused, Resident& r,
-                  const openvdb::FloatGrid::Ptr& logodds) const {
-        Tile tile;
-        tile.key = key;
-        tile.fused = std::move(fused);
-        tile.layers = r.layers;
-        if (logodds && logodds->activeVoxelCount() > 0) {
-            tile.layers.push_back(ToLayer(session_id, *logodds));
-        }
-        tile.products = r.products;
-        return tile;
-    }
-
-    TileVersion WriteVersion(const Tile& tile) {
-        TileVersion v;
-        v.key = tile.key;
-        v.version = NextVersion(tile.key);
-        v.file = impl.TileFile(tile.key, v.version);
-        const detail::EncodedTile encoded = detail::EncodeTile(tile);
-        detail::WriteTileFile(impl.dir / v.file, encoded.bytes);
-        v.bytes = encoded.bytes.size();
-        v.checksum = encoded.checksum;
-        return v;
-    }
-
-    TileVersion WriteLogOdds(const TileKey& key, const openvdb::FloatGrid::Ptr& logodds) {
+    // Writes a tile leaving memory: its next fused version and this session's layers.
+    std::pair<TileVersion, LayerFile> WriteTile(const TileKey& key, const core::VoxelMap& fused,
+                                                const openvdb::FloatGrid& logodds) const {
         TileVersion v;
         v.key = key;
-        v.file = LogOddsFile(key);
-        const detail::EncodedTile encoded = detail::EncodeGrids({logodds}, key);
-        detail::WriteTileFile(impl.dir / v.file, encoded.bytes);
-        v.bytes = encoded.bytes.size();
-        v.checksum = encoded.checksum;
-        return v;
+        v.version = NextVersion(key);
+        static_cast<FileRef&>(v) =
+            detail::WriteGrids(impl.dir, detail::FusedFileName(key, v.version), fused.Grids(), key);
+        LayerFile l;
+        l.key = key;
+        l.session = session_id;
+        if (logodds.activeVoxelCount() > 0) {
+            static_cast<FileRef&>(l) = detail::WriteGrids(
+                impl.dir, detail::LayerFileName(key, session_id), LayerGrids(session_id, logodds),
+                key);
+        }
+        return {v, l};
+    }
+
+    void Written(const TileVersion& v, const LayerFile& l) {
+        ++stats.tiles_written;
+        stats.bytes_written += v.bytes + l.bytes;
+        if (!l.file.empty()) ++stats.layers_written;
     }
 
     // Moves the least recently used tiles out of memory until the working set is under 3/4 of
@@ -221,38 +192,28 @@ struct SessionWriter::State {
         for (const auto& [age, key] : by_age) {
             if (bytes - freed <= target) break;
             victims.insert(key);
-            freed += resident.at(key).layer_bytes +
-                     (total ? bytes * leaves[key] / total : 0);
+            freed += total ? bytes * leaves[key] / total : 0;
         }
         if (victims.empty()) return;
         auto fused = detail::StealMapTiles(work, settings(), &victims);
         auto logodds = detail::StealTiles(*session, settings(), &victims);
         for (const TileKey& key : victims) {
-            Resident& r = resident.at(key);
-            if (r.dirty) {
+            if (resident.at(key).dirty) {
                 Pending& p = pending[key];
-                p.version = WriteVersion(Assemble(key, std::move(fused.at(key)), r, logodds.at(key)));
-                p.logodds = WriteLogOdds(key, logodds.at(key));
-                written_files.insert(p.version.file);
-                written_files.insert(p.logodds.file);
-                stats.tiles_written += 2;
-                stats.bytes_written += p.version.bytes + p.logodds.bytes;
+                written_files.insert(detail::FusedFileName(key, NextVersion(key)));
+                written_files.insert(detail::LayerFileName(key, session_id));
+                std::tie(p.version, p.layer) = WriteTile(key, fused.at(key), *logodds.at(key));
+                const std::string lo = detail::LayerFileName(key, session_id) + ".logodds";
+                written_files.insert(lo);
+                p.logodds = detail::WriteGrids(impl.dir, lo, {logodds.at(key)}, key);
+                Written(p.version, p.layer);
+                stats.bytes_written += p.logodds.bytes;
             }
             resident.erase(key);
             ++stats.tiles_evicted;
         }
-        openvdb::tools::pruneInactive(work.occupancy->tree());
-        openvdb::tools::pruneInactive(work.label->tree());
-        openvdb::tools::pruneInactive(work.label_weight->tree());
-        openvdb::tools::pruneInactive(work.endpoints->tree());
+        detail::PruneInactive(work);
         openvdb::tools::pruneInactive(session->tree());
-    }
-
-    void RemoveWrittenFiles() {
-        for (const std::string& file : written_files) {
-            std::error_code ignored;
-            fs::remove(impl.dir / file, ignored);
-        }
     }
 
     void Hook(const char* step) const {
@@ -262,12 +223,23 @@ struct SessionWriter::State {
 
 SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConfig& config,
                              SessionOptions options)
-    : state_(std::make_unique<State>(store, config, std::move(options))) {
+    : state_(std::make_unique<State>(*store.impl_, store, config, std::move(options))) {
     State& s = *state_;
     s.impl.RequireWriter("integrate");
     s.config.Validate();
+    const std::vector<std::string> conflicts =
+        detail::RuleConflicts(s.impl.settings.integration, s.config);
+    if (!conflicts.empty()) {
+        std::string what;
+        for (const std::string& c : conflicts) what += (what.empty() ? "" : "; ") + c;
+        throw InvalidArgumentError(s.impl.dir.string() +
+                                   ": the integration settings differ from the rule the map was "
+                                   "built with (" + what + ")");
+    }
     s.session_id = detail::NextSessionId(*s.impl.db);
-    for (const TileVersion& v : store.Latest().tiles) s.committed[v.key] = v;
+    for (const TileVersion& v : detail::ReadTiles(*s.impl.db, detail::LatestCommit(*s.impl.db))) {
+        s.committed[v.key] = v;
+    }
     s.last_versions = detail::ReadLastVersions(*s.impl.db);
     s.work = store.EmptyMap();
     s.session = openvdb::FloatGrid::create(0.0f);
@@ -277,7 +249,9 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
 }
 
 SessionWriter::~SessionWriter() {
-    if (state_ && !state_->done) state_->RemoveWrittenFiles();
+    if (state_ && !state_->done) {
+        state_->impl.RemoveFiles({state_->written_files.begin(), state_->written_files.end()});
+    }
 }
 
 int64_t SessionWriter::session_id() const { return state_->session_id; }
@@ -285,7 +259,7 @@ const WriterStats& SessionWriter::stats() const { return state_->stats; }
 
 integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
     State& s = *state_;
-    if (s.done) throw std::logic_error("the session is committed already");
+    if (s.done) throw InvalidArgumentError("the session is committed already");
     integration::ScanUpdate update;
     if (s.options.alignment.isIdentity()) {
         update = integration::ComputeScanUpdate(scan, s.work, s.config);
@@ -318,38 +292,35 @@ integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
 
 SessionRecord SessionWriter::Commit() {
     State& s = *state_;
-    if (s.done) throw std::logic_error("the session is committed already");
+    if (s.done) throw InvalidArgumentError("the session is committed already");
     const auto start = std::chrono::steady_clock::now();
     s.stats.peak_memory_bytes = std::max(s.stats.peak_memory_bytes, s.MemoryBytes());
 
-    // Every tile this session changed gets one new version: resident dirty tiles are written
-    // now, evicted ones already were.
+    // Every tile this session changed gets one new fused version and this session's layers:
+    // resident dirty tiles are written now, evicted ones already were. Nothing else is written.
     std::set<TileKey> dirty;
     for (const auto& [key, r] : s.resident) {
         if (r.dirty) dirty.insert(key);
     }
     auto fused = detail::StealMapTiles(s.work, s.settings(), &dirty);
     auto logodds = detail::StealTiles(*s.session, s.settings(), &dirty);
-    std::vector<Tile> tiles;
-    for (const TileKey& key : dirty) {
-        tiles.push_back(s.Assemble(key, std::move(fused.at(key)), s.resident.at(key),
-                                   logodds.at(key)));
+    const std::vector<TileKey> keys(dirty.begin(), dirty.end());
+    for (const TileKey& key : keys) {
+        s.written_files.insert(detail::FusedFileName(key, s.NextVersion(key)));
+        s.written_files.insert(detail::LayerFileName(key, s.session_id));
     }
-    std::vector<TileVersion> versions(tiles.size());
-    for (const Tile& tile : tiles) s.written_files.insert(s.impl.TileFile(tile.key, s.NextVersion(tile.key)));
-    tbb::parallel_for(size_t{0}, tiles.size(),
-                      [&](size_t i) { versions[i] = s.WriteVersion(tiles[i]); });
+    std::vector<std::pair<TileVersion, LayerFile>> files(keys.size());
+    detail::ParallelFor(keys.size(), [&](size_t i) {
+        files[i] = s.WriteTile(keys[i], fused.at(keys[i]), *logodds.at(keys[i]));
+    });
+    for (const auto& [v, l] : files) s.Written(v, l);
     for (const auto& [key, p] : s.pending) {
-        if (!dirty.count(key)) versions.push_back(p.version);
-    }
-    for (const TileVersion& v : versions) {
-        ++s.stats.tiles_written;
-        s.stats.bytes_written += v.bytes;
+        if (!dirty.count(key)) files.emplace_back(p.version, p.layer);
     }
     s.Hook("tiles_written");
 
     std::set<fs::path> dirs;
-    for (const TileVersion& v : versions) dirs.insert(s.impl.TileDir(v.key));
+    for (const auto& [v, l] : files) dirs.insert(s.impl.TileDir(v.key));
     for (const fs::path& dir : dirs) detail::SyncDirectory(dir);
     detail::SyncDirectory(s.impl.dir / "tiles");
     s.Hook("tiles_synced");
@@ -366,23 +337,22 @@ SessionRecord SessionWriter::Commit() {
     record.scans = s.scans.size();
     record.points = s.points;
     {
-        detail::Transaction tx(*s.impl.db, detail::Transaction::Kind::kWrite);
-        record.commit = detail::InsertCommit(*s.impl.db, "integrate", s.session_id);
-        detail::InsertSession(*s.impl.db, record);
-        detail::InsertScans(*s.impl.db, s.session_id, s.scans);
-        for (TileVersion& v : versions) {
+        const detail::Database& db = *s.impl.db;
+        detail::Transaction tx(db, detail::Transaction::Kind::kWrite);
+        record.commit = detail::InsertCommit(db, "integrate", s.session_id);
+        detail::InsertSession(db, record);
+        detail::InsertScans(db, s.session_id, s.scans);
+        for (auto& [v, l] : files) {
             v.commit = record.commit;
-            detail::InsertTileVersion(*s.impl.db, v);
+            detail::InsertTileVersion(db, v);
+            if (!l.file.empty()) detail::InsertLayer(db, l);
         }
         s.Hook("catalog_written");
         tx.Commit();
     }
     s.done = true;
     // The log-odds files served evictions only; a crash before this leaves them to gc.
-    for (const auto& [key, p] : s.pending) {
-        std::error_code ignored;
-        fs::remove(s.impl.dir / p.logodds.file, ignored);
-    }
+    for (const auto& [key, p] : s.pending) s.impl.RemoveFiles({p.logodds.file});
     s.stats.commit_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return record;

@@ -5,7 +5,27 @@
 
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
+
 namespace strata::store::detail {
+
+void ThrowKind(int sqlite_code, const std::string& message) {
+    switch (sqlite_code & 0xff) {
+        case SQLITE_CORRUPT:
+        case SQLITE_NOTADB:
+        case SQLITE_FORMAT:
+        case SQLITE_SCHEMA:
+            throw FormatError(message);
+        case SQLITE_IOERR:
+        case SQLITE_FULL:
+        case SQLITE_CANTOPEN:
+        case SQLITE_READONLY:
+        case SQLITE_PERM:
+            throw IoError(message);
+        default:
+            throw Error(message);
+    }
+}
 
 Statement::Statement(const Database& db, const char* sql) : db_(db) {
     if (sqlite3_prepare_v2(db.handle(), sql, -1, &stmt_, nullptr) != SQLITE_OK) {
@@ -109,10 +129,11 @@ Database::~Database() { sqlite3_close(db_); }
 
 void Database::Exec(const char* sql) const {
     char* message = nullptr;
-    if (sqlite3_exec(db_, sql, nullptr, nullptr, &message) != SQLITE_OK) {
+    const int rc = sqlite3_exec(db_, sql, nullptr, nullptr, &message);
+    if (rc != SQLITE_OK) {
         const std::string what = message ? message : "unknown error";
         sqlite3_free(message);
-        throw std::runtime_error(file_.string() + ": " + what);
+        ThrowKind(rc, file_.string() + ": " + what);
     }
 }
 
@@ -120,7 +141,8 @@ int64_t Database::LastInsertId() const { return sqlite3_last_insert_rowid(db_); 
 
 void Database::Fail(const std::string& what) const {
     const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
-    throw std::runtime_error(file_.string() + ": " + what + " (" + why + ")");
+    ThrowKind(db_ ? sqlite3_extended_errcode(db_) : SQLITE_NOMEM,
+              file_.string() + ": " + what + " (" + why + ")");
 }
 
 Transaction::Transaction(const Database& db, Kind kind) : db_(db) {

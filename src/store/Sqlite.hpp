@@ -1,6 +1,6 @@
 #pragma once
 // Private to the store: a thin RAII layer over SQLite (connection, statement, transaction) whose
-// errors are std::runtime_error naming the catalog file.
+// errors are kinds of strata::Error naming the catalog file.
 
 #include <cstdint>
 #include <filesystem>
@@ -12,6 +12,10 @@ struct sqlite3_stmt;
 namespace strata::store::detail {
 
 class Database;
+
+/// Throws the strata::Error kind for an SQLite result code: FormatError for a damaged or foreign
+/// file, IoError for a failed read or write, Error otherwise.
+[[noreturn]] void ThrowKind(int sqlite_code, const std::string& message);
 
 /// A prepared statement; columns and parameters are numbered as in SQLite (bind from 1, read
 /// from 0).
@@ -59,7 +63,7 @@ public:
     [[nodiscard]] Statement Prepare(const char* sql) const { return Statement(*this, sql); }
     [[nodiscard]] int64_t LastInsertId() const;
 
-    /// Throws std::runtime_error: "<file>: <what> (<SQLite's message>)".
+    /// Throws a kind of strata::Error: "<file>: <what> (<SQLite's message>)".
     [[noreturn]] void Fail(const std::string& what) const;
     [[nodiscard]] sqlite3* handle() const { return db_; }
     [[nodiscard]] const std::filesystem::path& file() const { return file_; }

@@ -1,6 +1,7 @@
 #pragma once
 // Private to the store: moving leaves between one big working grid and per-tile grids. Tile edges
-// are multiples of the 8-voxel leaf, so a leaf always belongs to exactly one tile.
+// are multiples of the 8-voxel leaf, so a leaf always belongs to exactly one tile. The grids of a
+// map are always enumerated through core::VoxelMap::Grids() / FromGrids(), never listed here.
 
 #include <map>
 #include <set>
@@ -9,9 +10,14 @@
 
 namespace strata::store::detail {
 
+/// The stock voxel grid types a map or a product may use (OpenVDB's GridTypes without the point
+/// grids, whose instantiation only costs compile time here).
+using VoxelGridTypes = openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<
+    openvdb::BoolGrid, openvdb::MaskGrid>;
+
 /// Moves every leaf of `from` that lies in one of `keys` (every leaf when `keys` is null) into a
-/// grid per tile, which shares `from`'s transform and metadata. Active tiles above leaf level
-/// must not exist (VoxelizeTiles).
+/// grid per tile, which shares `from`'s transform and metadata; every key of `keys` gets a grid.
+/// Active tiles above leaf level must not exist (VoxelizeTiles).
 template <typename GridT>
 std::map<TileKey, typename GridT::Ptr> StealTiles(GridT& from, const MapSettings& settings,
                                                    const std::set<TileKey>* keys) {
@@ -29,8 +35,7 @@ std::map<TileKey, typename GridT::Ptr> StealTiles(GridT& from, const MapSettings
     for (const auto& [key, origin] : leaves) {
         auto& grid = out[key];
         if (!grid) grid = from.copyWithNewTree();
-        grid->tree().addLeaf(
-            from.tree().template stealNode<LeafT>(origin, background, false));
+        grid->tree().addLeaf(from.tree().template stealNode<LeafT>(origin, background, false));
     }
     return out;
 }
@@ -45,10 +50,15 @@ void MergeLeaves(GridT& into, GridT& from) {
     for (LeafT* leaf : leaves) into.tree().addLeaf(leaf);
 }
 
-/// Splits the fused grids of a working map into per-tile maps (every grid present per tile).
+/// Splits the fused grids of a working map into per-tile maps (every grid present per tile;
+/// every key of `keys` gets a map, empty where the working map has nothing).
 std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapSettings& settings,
                                                 const std::set<TileKey>* keys);
-/// Moves a tile's fused grids into a working map.
+/// Moves a tile's fused grids into a working map (grids matched by name).
 void MergeMap(core::VoxelMap& into, core::VoxelMap& tile);
+/// Voxelizes active tiles above leaf level in every grid of a map (before StealMapTiles).
+void VoxelizeTiles(core::VoxelMap& map);
+/// Drops empty branches of every grid of a map (after leaves were stolen).
+void PruneInactive(core::VoxelMap& map);
 
 }  // namespace strata::store::detail

@@ -1,6 +1,6 @@
 // Opening a map whose catalog.sqlite was replaced by the input (seed: the catalog of a small
 // valid map): SQLite's own checks, then strata's reading of settings, sessions, tile versions
-// and checksums. Open + Latest + ReadTile + LoadMap + Check must throw a std::exception or
+// and checksums. Open + Latest + ReadFused + ReadLayer + LoadMap + Check must throw a std::exception or
 // succeed. The catalog is restored after each input.
 #include <fstream>
 #include <iterator>

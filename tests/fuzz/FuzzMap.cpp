@@ -1,10 +1,10 @@
 // Opening a map whose tile file was replaced by the input, as a damaged disk, a copy gone wrong
 // or a swapped file would leave it: the catalog still records the original size and XXH64
-// checksum, and Open + Latest + ReadTile + LoadMap + Check must refuse the file with a
+// checksum, and Open + Latest + ReadFused + ReadLayer + LoadMap + Check must refuse the file with a
 // std::exception (or succeed) before OpenVDB parses it. The tile is restored after each input.
 //
 // STRATA_FUZZ_MAP_FORGE=1 also records each input's size and checksum in the catalog (a forged
-// or buggy-writer tile), so the bytes reach OpenVDB's parser and DecodeTile. Off by default:
+// or buggy-writer tile), so the bytes reach OpenVDB's parser and DecodeFused. Off by default:
 // OpenVDB 10 itself has undefined behaviour on such input (docs/reliability.md, Fuzzing).
 #include <sqlite3.h>
 #include <xxhash.h>

@@ -40,7 +40,10 @@ void ReadWholeMap(const std::filesystem::path& dir) {
         const store::MapStore map = store::MapStore::Open(dir, store::MapStore::Access::kRead);
         const store::Snapshot snapshot = map.Latest();
         for (const store::TileVersion& version : snapshot.tiles) {
-            Refusal([&] { (void)map.ReadTile(version); });
+            Refusal([&] { (void)map.ReadFused(version); });
+        }
+        for (const store::LayerFile& layer : snapshot.layers) {
+            Refusal([&] { (void)map.ReadLayer(layer); });
         }
         Refusal([&] { (void)map.LoadMap(snapshot); });
         (void)map.Check();

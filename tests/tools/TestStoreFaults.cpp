@@ -23,6 +23,8 @@
 #include <vector>
 
 #include "CliTestUtil.hpp"
+#include "Format4Map.hpp"
+#include "StoreFaultUtil.hpp"
 #include "MapDiff.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/store/MapStore.hpp"
@@ -44,20 +46,22 @@ using strata::tools::test::Spawn;
 using strata::tools::test::Strata;
 using strata::tools::test::Temp;
 using strata::tools::test::Wait;
+using strata::tools::test::FaultSequence;
+using strata::tools::test::IntegrateArgs;
+using strata::tools::test::Join;
+using strata::tools::test::JsonIn;
+using strata::tools::test::KillAttempts;
+using strata::tools::test::LoadLatest;
+using strata::tools::test::OpenForReading;
+using strata::tools::test::SameMap;
+using strata::tools::test::Seed;
+using strata::tools::test::SessionCount;
+using strata::tools::test::kSequenceScans;
+using strata::tools::test::kTileM;
+using strata::tools::test::kVoxelM;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kVoxelM = 0.1;
-// 40 voxels: one scan touches ~12 tiles, so a commit writes ~12 files.
-constexpr double kTileM = 4.0;
 constexpr double kOneTileM = 64.0;  // with --origin 32,32,0 the whole room is in one tile
-constexpr int kSequenceScans = 4;
-constexpr unsigned kDefaultSeed = 20240611;  // STRATA_FAULT_SEED overrides it to reproduce a run
-// Kills per run of the crash test; STRATA_KILL_ATTEMPTS raises it for long local runs
-// (docs/reliability.md reports one of 120).
-int KillAttempts() {
-    const char* env = std::getenv("STRATA_KILL_ATTEMPTS");
-    return env && *env ? std::max(1, std::atoi(env)) : 20;
-}
 // Reader processes and the sessions the writer commits while they read.
 constexpr int kReaders = 3;
 constexpr int kWriterSessions = 6;
@@ -65,59 +69,6 @@ constexpr double kCommitMarginS = 0.05;  // the commit window starts a little ea
 constexpr double kHangGuardS = 5.0;  // a refused writer returns at once; this only catches hangs
 constexpr rlim_t kSmallFileLimit = 64 << 10;   // below one tile file (>100 kB) and a new catalog
 constexpr rlim_t kLargeFileLimit = 512 << 10;  // a new catalog fits, one 64 m tile (~1 MB) not
-
-// One scan (12k points in a 10 x 8 x 3 m room) per session: ~0.4 s per `strata integrate`, half
-// of it the commit of ~12 tile files of 100-300 kB (tiles hold every session's layers).
-SequenceSpec FaultSequence() {
-    SequenceSpec spec;
-    spec.scans = kSequenceScans;
-    spec.points_per_scan = 12000;
-    spec.room_half_m = Eigen::Vector3d(5.0, 4.0, 1.5);
-    return spec;
-}
-
-// Session `session` (1-based) integrates frame (session - 1) mod 4 of `seq`: the same session
-// number always gets the same input, in any map.
-std::vector<std::string> IntegrateArgs(const fs::path& map, const fs::path& seq, int session,
-                                       double tile_m = kTileM) {
-    return {"integrate",   map.string(),
-            "--kitti",     seq.string(),
-            "--frames",    std::to_string((session - 1) % kSequenceScans),
-            "--voxel",     std::to_string(kVoxelM),
-            "--tile-size", std::to_string(tile_m)};
-}
-
-std::string Join(const std::vector<std::string>& words) {
-    std::string line;
-    for (const std::string& w : words) line += (line.empty() ? "" : " ") + w;
-    return line;
-}
-
-// The JSON object in a command's output (stderr lines, unbuffered, may come before it).
-nlohmann::json JsonIn(const std::string& out) {
-    const size_t begin = out.find('{');
-    const size_t end = out.rfind('}');
-    if (begin == std::string::npos || end == std::string::npos) return {};
-    return nlohmann::json::parse(out.substr(begin, end - begin + 1), nullptr, false);
-}
-
-MapStore OpenForReading(const fs::path& map) {
-    return MapStore::Open(map, MapStore::Access::kRead);
-}
-
-size_t SessionCount(const fs::path& map) { return OpenForReading(map).Latest().sessions.size(); }
-
-VoxelMap LoadLatest(const fs::path& map) {
-    const MapStore store = OpenForReading(map);
-    return store.LoadMap(store.Latest());
-}
-
-// Exact equality of two maps, voxel by voxel: occupancy, label, label weight and hits.
-::testing::AssertionResult SameMap(const VoxelMap& actual, const VoxelMap& expected) {
-    const std::string diff = strata::testing::MapDifference(actual, expected);
-    if (!diff.empty()) return ::testing::AssertionFailure() << diff;
-    return ::testing::AssertionSuccess();
-}
 
 // The maps a run without faults produces, built one session ahead of the map under test (which
 // has n or n + 1 sessions after an attempt at session n + 1), and how long each session took.
@@ -165,11 +116,6 @@ private:
     std::map<int, VoxelMap> maps_;
     std::map<int, Timing> timings_;
 };
-
-unsigned Seed() {
-    const char* env = std::getenv("STRATA_FAULT_SEED");
-    return env && *env ? static_cast<unsigned>(std::stoul(env)) : kDefaultSeed;
-}
 
 // Every file the map directory may hold besides tiles/ (SQLite's WAL files come and go).
 bool IsMapFile(const std::string& name) {
@@ -642,11 +588,11 @@ TEST(StoreFaults, DamagedTileFilesAreNamed) {
 
     for (const auto& tile : tiles) {
         if (tile.file == flipped.file || tile.file == truncated.file) continue;
-        EXPECT_NO_THROW((void)store.ReadTile(tile)) << tile.file;
+        EXPECT_NO_THROW((void)store.ReadFused(tile)) << tile.file;
     }
     const auto error_of = [&](const strata::store::TileVersion& tile) -> std::string {
         try {
-            (void)store.ReadTile(tile);
+            (void)store.ReadFused(tile);
         } catch (const std::runtime_error& e) {
             return e.what();
         }
@@ -684,6 +630,91 @@ TEST(StoreFaults, NewerFormatsAndNonMapsAreRefused) {
     const Result r = Strata("info " + empty.string());
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("not a strata map"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// The integration rule is recorded when the map is created: a later `integrate` with a flag that
+// contradicts it fails naming the flag, the map's value and the given one, and writes nothing; the
+// same flag with the map's value, or no flag, is fine.
+TEST(StoreFaults, IntegrateRefusesFlagsThatContradictTheMapsRule) {
+    const Fixture f = MakeMap("faults_rule", 0);
+    std::vector<std::string> first = IntegrateArgs(f.map, f.seq, 1);
+    first.insert(first.end(), {"--max-range", "30"});
+    ASSERT_EQ(Strata(Join(first)).code, 0);
+    const auto files_before = MapFiles(f.map);
+    for (const auto& [flag, named] : std::vector<std::pair<std::string, std::string>>{
+             {"--max-range 40", "--max-range 40: "},
+             {"--min-range 1", "--min-range 1: "},
+             {"--points-only", "--points-only: "},
+             {"--no-point-means", "--no-point-means: "}}) {
+        const Result r = Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " " + flag);
+        EXPECT_EQ(r.code, 2) << flag << ": " << r.out;  // a usage error
+        EXPECT_NE(r.out.find(named), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find(f.map.string()), std::string::npos) << r.out;
+    }
+    EXPECT_NE(Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " --max-range 40").out.find(
+                  "built with --max-range 30"),
+              std::string::npos);
+    EXPECT_EQ(MapFiles(f.map), files_before);
+    EXPECT_EQ(SessionCount(f.map), 1u);
+    const Result same = Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " --max-range 30");
+    EXPECT_EQ(same.code, 0) << same.out;
+    const Result none = Strata(Join(IntegrateArgs(f.map, f.seq, 3)));
+    EXPECT_EQ(none.code, 0) << none.out;
+    EXPECT_NE(none.out.find("range [0, 30] m"), std::string::npos) << none.out;
+    EXPECT_EQ(OpenForReading(f.map).settings().integration.max_range_m, 30.0);
+}
+
+// History you can drop: `gc --keep-last` keeps the newest snapshots, `info --json` reports the
+// bytes by kind before and after, `--as-of` an older session is refused saying why, and the
+// session's layers still serve `diff`.
+TEST(StoreFaults, GcKeepLastDropsOldHistoryAndInfoShowsTheBytes) {
+    const Fixture f = MakeMap("faults_history", 4);
+    const nlohmann::json before = JsonIn(Strata("info " + f.map.string() + " --json").out);
+    ASSERT_TRUE(before.contains("bytes")) << before.dump();
+    const nlohmann::json& b = before["bytes"];
+    EXPECT_GT(b["fused_current"].get<uint64_t>(), 0u);
+    EXPECT_GT(b["fused_older"].get<uint64_t>(), 0u);
+    EXPECT_GT(b["layers"].get<uint64_t>(), 0u);
+    EXPECT_EQ(b["products"].get<uint64_t>(), 0u);
+    EXPECT_EQ(before["history_start_commit"].get<int64_t>(), 1);
+    const Result bad = Strata("gc " + f.map.string() + " --keep-last 2 --keep-since 2024-01-01");
+    EXPECT_EQ(bad.code, 2) << bad.out;
+    EXPECT_NE(bad.out.find("exactly one"), std::string::npos) << bad.out;
+    const Result gc = Strata("gc " + f.map.string() + " --keep-last 1");
+    ASSERT_EQ(gc.code, 0) << gc.out;
+    EXPECT_NE(gc.out.find("history kept from commit 5"), std::string::npos) << gc.out;
+    const nlohmann::json after = JsonIn(Strata("info " + f.map.string() + " --json").out);
+    EXPECT_EQ(after["bytes"]["fused_older"].get<uint64_t>(), 0u);
+    EXPECT_EQ(after["bytes"]["layers"], b["layers"]);
+    EXPECT_EQ(after["occupied_voxels"], before["occupied_voxels"]);
+    EXPECT_LT(after["disk_bytes"].get<uint64_t>(), before["disk_bytes"].get<uint64_t>());
+    const Result as_of = Strata("info " + f.map.string() + " --as-of 1");
+    EXPECT_EQ(as_of.code, 5) << as_of.out;  // not found: no longer kept
+    EXPECT_NE(as_of.out.find("no longer kept"), std::string::npos) << as_of.out;
+    const Result diff = Strata("diff " + f.map.string() + " --from 1 --to 4 --json");
+    EXPECT_EQ(diff.code, 0) << diff.out;
+    EXPECT_EQ(Strata("check " + f.map.string()).code, 0);
+}
+
+// `strata upgrade` says what it did, and that a current map needs nothing.
+TEST(StoreFaults, UpgradeSaysWhatItDid) {
+    const Fixture f = MakeMap("faults_upgrade", 2);
+    const Result current = Strata("upgrade " + f.map.string());
+    EXPECT_EQ(current.code, 0) << current.out;
+    EXPECT_NE(current.out.find("format 5 already"), std::string::npos) << current.out;
+    strata::test::RewriteAsFormat4(f.map);
+    const Result info = Strata("info " + f.map.string());
+    EXPECT_EQ(info.code, 6) << info.out;  // bad format: says how to upgrade
+    EXPECT_NE(info.out.find("strata upgrade " + f.map.string()), std::string::npos) << info.out;
+    const Result upgrade = Strata("upgrade " + f.map.string());
+    EXPECT_EQ(upgrade.code, 0) << upgrade.out;
+    EXPECT_NE(upgrade.out.find("format 4 -> 5"), std::string::npos) << upgrade.out;
+    EXPECT_EQ(Strata("check " + f.map.string()).code, 0);
+    EXPECT_EQ(SessionCount(f.map), 2u);
 }
 
 }  // namespace

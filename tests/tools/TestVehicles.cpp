@@ -77,7 +77,7 @@ TEST(VehiclesCli, StoresTheCleanedMapAsOneCommitThatAsOfCanUndo) {
     EXPECT_GT(picture.width(), picture.height());  // before and after, side by side
     {
         const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
-        EXPECT_GE(store.Vehicles().size(), kMinVehicles);
+        EXPECT_GE(store.ProductRows("vehicles").size(), kMinVehicles);
         EXPECT_TRUE(store.Check().ok());
     }
     // The export of the latest commit is the cleaned map; as of the session, the map as scanned.

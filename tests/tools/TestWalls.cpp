@@ -2,6 +2,7 @@
 // leaning 4 degrees towards the street at x 22-38 m, y -9 m).
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -111,23 +112,38 @@ TEST(WallsCli, StoresTheProductsInTheMap) {
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_NE(r.out.find("stored slant_deg and wall_id grids"), std::string::npos) << r.out;
     const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
-    const auto walls = store.Walls();
+    const auto walls = store.ProductRows("walls");
     ASSERT_FALSE(walls.empty());
     size_t stored = 0;
-    for (const auto& v : store.Latest().tiles) {
-        for (const auto& g : store.ReadTile(v).products) {
+    for (const auto& p : store.Latest().products) {
+        for (const auto& g : store.ReadProduct(p)) {
             if (g->getName() == "slant_deg") stored += g->activeVoxelCount();
         }
     }
     size_t inliers = 0;
-    for (const auto& w : walls) inliers += w.inliers;
+    for (const auto& w : walls) inliers += nlohmann::json::parse(w.json)["inliers"].get<size_t>();
     // Every inlier voxel is stored once; a voxel two walls share (a corner) keeps one id.
     EXPECT_LE(stored, inliers);
     EXPECT_GE(stored, static_cast<size_t>(kMinDistinctInliers * inliers));
     EXPECT_TRUE(store.Check().ok());
+    // `sqlite3 MAP/catalog.sqlite 'select * from walls'` still answers, with the walls' columns.
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open_v2((map / "catalog.sqlite").c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
+              SQLITE_OK);
+    sqlite3_stmt* q = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(db, "SELECT count(*), sum(inliers), min(slant_deg) FROM walls",
+                                 -1, &q, nullptr),
+              SQLITE_OK)
+        << sqlite3_errmsg(db);
+    ASSERT_EQ(sqlite3_step(q), SQLITE_ROW);
+    EXPECT_EQ(static_cast<size_t>(sqlite3_column_int64(q, 0)), walls.size());
+    EXPECT_EQ(static_cast<size_t>(sqlite3_column_int64(q, 1)), inliers);
+    EXPECT_GT(sqlite3_column_double(q, 2), 0.0);
+    sqlite3_finalize(q);
+    sqlite3_close(db);
     // Running again replaces them; the map as of the session is readable and has none.
     EXPECT_EQ(Strata("walls " + map.string()).code, 0);
-    EXPECT_EQ(store::MapStore::Open(map, store::MapStore::Access::kRead).Walls().size(),
+    EXPECT_EQ(store::MapStore::Open(map, store::MapStore::Access::kRead).ProductRows("walls").size(),
               walls.size());
     EXPECT_EQ(Strata("walls " + map.string() + " --as-of 1 --json").code, 0);
 }
@@ -149,7 +165,8 @@ TEST(WallsCli, BadInputFailsNamingTheProblemAndLeavesTheMap) {
         EXPECT_NE(r.out.find(what), std::string::npos) << args << ": " << r.out;
     }
     EXPECT_EQ(MapFiles(map), before);
-    EXPECT_TRUE(store::MapStore::Open(map, store::MapStore::Access::kRead).Walls().empty());
+    EXPECT_TRUE(
+        store::MapStore::Open(map, store::MapStore::Access::kRead).ProductRows("walls").empty());
 }
 
 }  // namespace

@@ -51,7 +51,8 @@ TEST(ViewService, ServesThePageThreeJsAndAManifestOfEveryPinnedSnapshot) {
     EXPECT_EQ(m["snapshots"][0]["as_of_session"], 0);
     EXPECT_EQ(m["snapshots"][1]["as_of_session"], 1);
     EXPECT_EQ(m["snapshots"][2]["as_of_session"], 2);
-    EXPECT_EQ(m["snapshots"][0]["commit"], Map().walls_commit);
+    // Each saved change set is a commit of its own after the walls' (format 5, store.md).
+    EXPECT_EQ(m["snapshots"][0]["commit"], Map().walls_commit + 2);
     ASSERT_EQ(m["walls"].size(), 1u);
     EXPECT_DOUBLE_EQ(m["walls"][0]["slant_deg"].get<double>(), kNorthWallSlant);
     ASSERT_EQ(m["change_sets"].size(), 2u);
@@ -150,15 +151,20 @@ TEST(ViewService, ADiffBetweenSessionsIsWhatStrataDiffReportsAndHoldsTheCrate) {
 
 TEST(ViewService, ASavedChangeSetIsRebuiltWhenItsSidesAreSessionsAndOnlyThen) {
     const auto service = Service(Map().dir);
-    const json between = Get(*service, "/api/changeset/1");
+    // Change set ids are product row ids, unique in the map (the wall row came first).
+    const json sets = Get(*service, "/api/map")["change_sets"];
+    ASSERT_EQ(sets.size(), 2u);
+    const std::string first = std::to_string(sets[0]["id"].get<int64_t>());
+    const std::string second = std::to_string(sets[1]["id"].get<int64_t>());
+    const json between = Get(*service, "/api/changeset/" + first);
     EXPECT_TRUE(between["voxels"].get<bool>());
     EXPECT_EQ(between["record"]["to"], "session 2");
     EXPECT_FALSE(between["tiles"].empty());
-    const json scans = Get(*service, "/api/changeset/2");
+    const json scans = Get(*service, "/api/changeset/" + second);
     EXPECT_FALSE(scans["voxels"].get<bool>());
     EXPECT_TRUE(scans["tiles"].empty());
-    EXPECT_EQ(service->Get("/api/changeset/2/0/0/0").status, 404);
-    EXPECT_EQ(service->Get("/api/changeset/7").status, 404);
+    EXPECT_EQ(service->Get("/api/changeset/" + second + "/0/0/0").status, 404);
+    EXPECT_EQ(service->Get("/api/changeset/999").status, 404);
 }
 
 TEST(ViewService, AVoxelRecordHoldsEveryValueAndTheWallRowItBelongsTo) {
@@ -235,11 +241,11 @@ TEST(ViewService, KeepsServingItsSnapshotWhileTheMapMovesOn) {
 TEST(ViewService, ADamagedTileFileStopsTheStartWithItsNameAndTheMapUntouched) {
     const TestMap map = BuildTestMap("damaged");
     const json tile = Get(*Service(map.dir), "/api/map")["snapshots"][0]["tiles"][0];
-    // MAP/tiles/X_Y/vN.vdb (MapStore.hpp): a version the newest snapshot reads.
+    // MAP/tiles/X_Y/fN.vdb (MapStore.hpp): a fused version the newest snapshot reads.
     const fs::path victim =
         map.dir / "tiles" /
         (std::to_string(tile["x"].get<int>()) + "_" + std::to_string(tile["y"].get<int>())) /
-        ("v" + std::to_string(tile["version"].get<int64_t>()) + ".vdb");
+        ("f" + std::to_string(tile["version"].get<int64_t>()) + ".vdb");
     ASSERT_TRUE(fs::is_regular_file(victim));
     {
         std::fstream file(victim, std::ios::in | std::ios::out | std::ios::binary);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <vector>
@@ -116,33 +117,46 @@ inline TestMap BuildTestMap(const std::string& name) {
             id->tree().setValue(v.getCoord(), 1);
         }
     }
-    store::WallRecord wall;
-    wall.wall_id = 1;
-    wall.center = Eigen::Vector3d(0.0, kNorthWallY, 0.0);
-    wall.normal = Eigen::Vector3d(0.0, -1.0, 0.0);
-    wall.slant_deg = kNorthWallSlant;
-    wall.length_m = 12.0;
-    wall.height_m = 3.0;
-    out.walls_commit = map.CommitProducts("walls", {slant, id}, {wall});
+    store::ProductCommit walls;  // as `strata walls` stores them (tools/strata/Walls.cpp)
+    walls.kind = "walls";
+    walls.grids = {slant, id};
+    walls.rows.push_back(nlohmann::json{
+        {"wall_id", 1},
+        {"center_x", 0.0},
+        {"center_y", kNorthWallY},
+        {"center_z", 0.0},
+        {"normal_x", 0.0},
+        {"normal_y", -1.0},
+        {"normal_z", 0.0},
+        {"slant_deg", kNorthWallSlant},
+        {"length_m", 12.0},
+        {"height_m", 3.0}}.dump());
+    out.walls_commit = map.CommitProduct(walls);
 
     // A change set between the sessions, as `strata diff --from 1 --to 2 --save` keeps it.
     change::MapObserver observer(map);
     const change::ChangeQuery query;
     const change::ChangeSet changes =
         change::DetectChanges(observer.Session(1), observer.Session(2), kVoxel, query);
-    store::ChangeSetRecord record;
-    record.from = "session 1";
-    record.to = "session 2";
-    record.added_voxels = changes.added_voxels_total;
-    record.removed_voxels = changes.removed_voxels_total;
-    record.unknown_voxels = changes.unknown_voxels;
-    record.objects = changes.objects.size();
-    record.report = change::ChangeReportJson(
-        changes, {record.from, record.to, Eigen::Vector3d::Zero(), &query});
-    (void)map.SaveChangeSet(record);
+    // As tools/strata/Diff.cpp stores it.
+    const auto save = [&](const std::string& from, const std::string& to) {
+        store::ProductCommit set;
+        set.kind = "change_sets";
+        set.rows.push_back(
+            nlohmann::json{{"from_side", from},
+                           {"to_side", to},
+                           {"added_voxels", changes.added_voxels_total},
+                           {"removed_voxels", changes.removed_voxels_total},
+                           {"unknown_voxels", changes.unknown_voxels},
+                           {"objects", changes.objects.size()},
+                           {"report", nlohmann::json::parse(change::ChangeReportJson(
+                                          changes, {from, to, Eigen::Vector3d::Zero(), &query}))}}
+                .dump());
+        (void)map.CommitProduct(set);
+    };
+    save("session 1", "session 2");
     // One whose "after" side was scans never committed: its voxels cannot be rebuilt.
-    record.to = "scans new_drive/ (3, uncommitted)";
-    (void)map.SaveChangeSet(record);
+    save("session 1", "scans new_drive/ (3, uncommitted)");
     return out;
 }
 

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "Commands.hpp"
+#include "strata/core/Error.hpp"
 #include "MapAccess.hpp"
 #include "ScanSource.hpp"
 #include "strata/change/ChangeReport.hpp"
@@ -37,6 +38,7 @@ struct DiffArgs {
     std::string png;
     bool save = false;
     bool list = false;
+    double memory_budget_mb = store::TileReader::kDefaultBudgetBytes / 1e6;
 };
 
 constexpr const char* kSideHelp =
@@ -68,37 +70,42 @@ Side ObserveScans(const DiffArgs& args, const store::MapStore& map) {
                                                       args.poses, read_options)
                                   : ScanSource::Kitti(args.to_kitti, args.frames);
     core::VoxelMap scratch = map.EmptyMap();  // the Observation shares its grids
-    integration::Integrator integrator(scratch, integration::IntegrationConfig{});
+    // The rule the map was built with, so the two sides weigh evidence alike.
+    integration::Integrator integrator(scratch, map.settings().integration);
     for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
     return {change::ObserveMap(scratch),
             "scans " + source.Describe() + " (" + std::to_string(source.size()) + ", uncommitted)"};
 }
 
+// Saved change sets are the rows of the map's `change_sets` commits (`SELECT * FROM
+// change_sets`), every one of them, oldest first.
 void List(const DiffArgs& args) {
     const store::MapStore map = OpenMap(args.map);
-    const std::vector<store::ChangeSetRecord> sets = map.ChangeSets();
-    if (args.json) {
-        nlohmann::json j = nlohmann::json::array();
-        for (const store::ChangeSetRecord& r : sets) {
-            j.push_back({{"id", r.id},
-                         {"commit", r.commit},
-                         {"created_utc", r.created_utc},
-                         {"from", r.from},
-                         {"to", r.to},
-                         {"added_voxels", r.added_voxels},
-                         {"removed_voxels", r.removed_voxels},
-                         {"unknown_voxels", r.unknown_voxels},
-                         {"objects", r.objects},
-                         {"report", nlohmann::json::parse(r.report)}});
+    nlohmann::json sets = nlohmann::json::array();
+    for (const store::ProductRow& row : map.ProductHistory("change_sets")) {
+        nlohmann::json j = nlohmann::json::parse(row.json, nullptr, false);
+        if (!j.is_object()) {
+            throw FormatError(map.dir().string() + ": change set " + std::to_string(row.id) +
+                              " is damaged");
         }
-        std::cout << j.dump(2) << "\n";
+        // The list keeps the keys it always had: the view's from_side/to_side as from/to.
+        nlohmann::json entry = {{"id", row.id}, {"commit", row.commit},
+                                {"created_utc", row.time_utc}};
+        for (const auto& [key, value] : j.items()) {
+            entry[key == "from_side" ? "from" : key == "to_side" ? "to" : key] = value;
+        }
+        sets.push_back(entry);
+    }
+    if (args.json) {
+        std::cout << sets.dump(2) << "\n";
         return;
     }
     if (sets.empty()) std::cout << "no saved change sets (strata diff ... --save keeps one)\n";
-    for (const store::ChangeSetRecord& r : sets) {
-        std::cout << r.id << "  " << r.created_utc << "  " << r.from << " -> " << r.to << ": "
-                  << r.objects << " objects, +" << r.added_voxels << " / -" << r.removed_voxels
-                  << " voxels\n";
+    for (const nlohmann::json& r : sets) {
+        std::cout << r["id"] << "  " << r.value("created_utc", "") << "  "
+                  << r.value("from", "") << " -> " << r.value("to", "") << ": "
+                  << r.value("objects", 0) << " objects, +" << r.value("added_voxels", 0)
+                  << " / -" << r.value("removed_voxels", 0) << " voxels\n";
     }
 }
 
@@ -127,6 +134,7 @@ void Run(const DiffArgs& args) {
         throw std::invalid_argument("give exactly one of --to SIDE, --to-kitti SEQ, --to-scans");
     }
     if (args.from.empty() && !scans) throw std::invalid_argument("--from SIDE is required");
+    if (args.memory_budget_mb < 0.0) throw std::invalid_argument("--memory-budget must be >= 0");
     if (args.min_voxels < 1) throw std::invalid_argument("--min-voxels must be at least 1");
     if (args.gap < 0) throw std::invalid_argument("--gap must be >= 0");
     if (args.tolerance < 0 || args.margin < 0 || args.grow < 0 || args.support < 0) {
@@ -146,7 +154,8 @@ void Run(const DiffArgs& args) {
     // --save writes the catalog: open as the writer up front, so a busy map fails before work.
     store::MapStore map = OpenMap(
         args.map, args.save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    change::MapObserver observer(map, query.region);
+    change::MapObserver observer(map, query.region,
+                                 static_cast<size_t>(args.memory_budget_mb * 1e6));
     const Side a = Resolve(args.from.empty() ? "map" : args.from, map, observer);
     const Side b = scans ? ObserveScans(args, map) : Resolve(args.to, map, observer);
 
@@ -167,16 +176,19 @@ void Run(const DiffArgs& args) {
         PrintSummary(changes, a, b);
     }
     if (args.save) {
-        store::ChangeSetRecord record;
-        record.from = a.name;
-        record.to = b.name;
-        record.added_voxels = changes.added_voxels_total;
-        record.removed_voxels = changes.removed_voxels_total;
-        record.unknown_voxels = changes.unknown_voxels;
-        record.objects = changes.objects.size();
-        record.report = report;
-        const int64_t id = map.SaveChangeSet(record);
-        (args.json ? std::cerr : std::cout) << "saved as change set " << id << "\n";
+        store::ProductCommit product;
+        product.kind = "change_sets";
+        product.rows.push_back(nlohmann::json{{"from_side", a.name},
+                                              {"to_side", b.name},
+                                              {"added_voxels", changes.added_voxels_total},
+                                              {"removed_voxels", changes.removed_voxels_total},
+                                              {"unknown_voxels", changes.unknown_voxels},
+                                              {"objects", changes.objects.size()},
+                                              {"report", nlohmann::json::parse(report)}}
+                                   .dump());
+        (void)map.CommitProduct(product);
+        (args.json ? std::cerr : std::cout)
+            << "saved as change set " << map.ProductRows("change_sets").back().id << "\n";
     }
 }
 
@@ -227,6 +239,10 @@ void RegisterDiff(CLI::App& app) {
     cmd->add_option("--vdb", args->vdb, "Write the added and removed grids to a .vdb file");
     cmd->add_option("--png", args->png, "Write a top-down picture (removed red, added green)");
     cmd->add_flag("--save", args->save, "Keep the result in the map's catalog");
+    cmd->add_option("--memory-budget", args->memory_budget_mb,
+                    "Keep at most this many MB of decoded tiles cached between the sides "
+                    "(0 = none)")
+        ->capture_default_str();
     cmd->add_flag("--list", args->list, "List the saved change sets");
     cmd->callback([args] { Run(*args); });
 }

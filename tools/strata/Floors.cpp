@@ -3,6 +3,7 @@
 #include "strata/registration/Floors.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -20,6 +21,53 @@ namespace strata::tools {
 namespace {
 
 namespace reg = registration;
+
+// A storey of a building map (`strata stack`): the session that mapped it in its own frame, where
+// that frame sits in the map, and the height of its floor surface. The storeys of a map are the
+// rows of its newest `floors` commit (`SELECT * FROM floors`).
+struct FloorRecord {
+    int index = 0;
+    int64_t session = 0;
+    double z_m = 0.0;  // floor surface height in the map frame
+    Eigen::Matrix4d T_map_floor = Eigen::Matrix4d::Identity();  // session frame -> map frame
+};
+
+std::vector<FloorRecord> ReadFloors(const store::MapStore& map) {
+    std::vector<FloorRecord> floors;
+    for (const store::ProductRow& row : map.ProductRows("floors")) {
+        const nlohmann::json j = nlohmann::json::parse(row.json, nullptr, false);
+        FloorRecord f;
+        try {
+            f.index = j.at("floor").get<int>();
+            f.session = j.at("session").get<int64_t>();
+            f.z_m = j.at("z_m").get<double>();
+            const std::vector<double> T = j.at("T_map_floor").get<std::vector<double>>();
+            if (T.size() != 16) throw std::out_of_range("T_map_floor needs 16 numbers");
+            for (int i = 0; i < 16; ++i) f.T_map_floor(i / 4, i % 4) = T[static_cast<size_t>(i)];
+        } catch (const std::exception& e) {
+            throw FormatError(map.dir().string() + ": floor row " + std::to_string(row.id) +
+                              " is damaged (" + e.what() + ")");
+        }
+        floors.push_back(f);
+    }
+    std::sort(floors.begin(), floors.end(),
+              [](const FloorRecord& a, const FloorRecord& b) { return a.index < b.index; });
+    return floors;
+}
+
+// Stores every storey as one `floors` commit (the newest commit of a kind is what it says).
+void WriteFloors(store::MapStore& map, const std::vector<FloorRecord>& floors) {
+    store::ProductCommit product;
+    product.kind = "floors";
+    for (const FloorRecord& f : floors) {
+        std::vector<double> T;
+        for (int i = 0; i < 16; ++i) T.push_back(f.T_map_floor(i / 4, i % 4));
+        product.rows.push_back(nlohmann::json{
+            {"floor", f.index}, {"session", f.session}, {"z_m", f.z_m}, {"T_map_floor", T}}
+                                   .dump());
+    }
+    (void)map.CommitProduct(product);
+}
 
 std::vector<Eigen::Vector3d> Moved(std::vector<Eigen::Vector3d> points, const Eigen::Matrix4d& T) {
     const Eigen::Isometry3d iso(T);
@@ -54,15 +102,15 @@ void RunStack(const StackArgs& args) {
     store::MapStore map = OpenMap(args.map, store::MapStore::Access::kWrite);
     const store::Snapshot snapshot = map.Latest();
     const int64_t session = map.FindSession(args.session);
-    std::vector<store::FloorRecord> floors = map.Floors();
-    for (const store::FloorRecord& f : floors) {
+    std::vector<FloorRecord> floors = ReadFloors(map);
+    for (const FloorRecord& f : floors) {
         if (f.session == session) {
             throw InvalidArgumentError("session " + std::to_string(session) + " is floor " +
                                        std::to_string(f.index) + " already");
         }
     }
     // No floor yet: the oldest other session is the ground floor, in the map frame.
-    store::FloorRecord base;
+    FloorRecord base;
     if (floors.empty()) {
         for (const store::SessionRecord& s : snapshot.sessions) {
             if (s.id != session) {
@@ -76,7 +124,7 @@ void RunStack(const StackArgs& args) {
         }
         floors.push_back(base);
     }
-    const store::FloorRecord& below = floors.back();
+    const FloorRecord below = floors.back();
     reg::FloorStackConfig config;
     config.z_bias_m = args.z_bias;
     config.slice = args.slice;
@@ -94,7 +142,7 @@ void RunStack(const StackArgs& args) {
     a.result = r.result;
     a.map_points = reference.size();
     a.total_ms = r.result.time_ms;
-    store::FloorRecord record;
+    FloorRecord record;
     record.index = below.index + 1;
     record.session = session;
     record.T_map_floor = r.result.T_map_source.matrix();
@@ -120,8 +168,12 @@ void RunStack(const StackArgs& args) {
         std::cout << "\n";
     }
     RequireAccepted(a, "stacking session " + std::to_string(session));
-    if (map.Floors().empty()) map.RecordFloor(base);
-    map.RecordFloor(record);
+    if (!std::isfinite(record.z_m) || !record.T_map_floor.allFinite()) {
+        throw RefusedError("stacking session " + std::to_string(session) +
+                           ": the transform is not finite");
+    }
+    floors.push_back(record);
+    WriteFloors(map, floors);
 }
 
 struct LocalizeArgs {
@@ -152,8 +204,8 @@ core::Scan ReadScan(const std::string& file) {
 void RunLocalize(const LocalizeArgs& args) {
     args.slice.Validate();
     const store::MapStore map = OpenMap(args.map);
-    const std::vector<store::FloorRecord> floors = map.Floors();
-    const auto it = std::find_if(floors.begin(), floors.end(), [&](const store::FloorRecord& f) {
+    const std::vector<FloorRecord> floors = ReadFloors(map);
+    const auto it = std::find_if(floors.begin(), floors.end(), [&](const FloorRecord& f) {
         return f.index == args.floor;
     });
     if (it == floors.end()) {
@@ -165,7 +217,7 @@ void RunLocalize(const LocalizeArgs& args) {
     const store::Snapshot snapshot = map.Latest();
     std::vector<Eigen::Vector3d> slice;
     const Eigen::AlignedBox3d box = args.slice.Box(it->z_m);
-    for (const store::FloorRecord& f : floors) {
+    for (const FloorRecord& f : floors) {
         for (const Eigen::Vector3d& p :
              Moved(reg::SessionPoints(map, snapshot, f.session), f.T_map_floor)) {
             if (box.contains(p)) slice.push_back(p);

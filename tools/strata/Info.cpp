@@ -17,14 +17,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Bytes of every file under `dir`.
-uint64_t DiskUse(const fs::path& dir) {
+// Bytes of every file under `dir` (whose name starts with `prefix`, when given).
+uint64_t DiskUse(const fs::path& dir, const std::string& prefix = "") {
     uint64_t bytes = 0;
     std::error_code ec;
     for (auto it = fs::recursive_directory_iterator(dir, ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
         std::error_code ignored;
-        if (it->is_regular_file(ignored)) bytes += it->file_size(ignored);
+        if (!it->is_regular_file(ignored)) continue;
+        if (it->path().filename().string().rfind(prefix, 0) == 0) {
+            bytes += it->file_size(ignored);
+        }
     }
     return bytes;
 }
@@ -70,12 +73,17 @@ nlohmann::json Describe(const store::MapStore& store, const std::string& as_of) 
     size_t memory = 0;
     for (const auto& g : map.Grids()) memory += g->memUsage();
     j["memory_bytes"] = memory;
-    uint64_t tile_bytes = 0;
-    for (const store::TileVersion& t : snapshot.tiles) tile_bytes += t.bytes;
+    const store::StorageBytes bytes = store.Bytes(snapshot);
     j["tiles"] = snapshot.tiles.size();
-    j["tile_bytes"] = tile_bytes;          // the tiles this snapshot reads
-    j["tile_versions"] = store.TileFileCount();        // every version kept, history included
-    j["disk_bytes"] = DiskUse(store.dir());  // catalog, all versions, garbage
+    j["tile_bytes"] = bytes.fused_current;  // the fused files this snapshot reads
+    j["tile_versions"] = store.TileFileCount();  // every fused version kept, history included
+    j["history_start_commit"] = store.HistoryStart();
+    j["bytes"] = {{"fused_current", bytes.fused_current},
+                  {"fused_older", bytes.fused_older},
+                  {"layers", bytes.layers},
+                  {"products", bytes.products},
+                  {"catalog", DiskUse(store.dir(), "catalog.sqlite")}};
+    j["disk_bytes"] = DiskUse(store.dir());  // catalog, all files, garbage
     j["sessions"] = nlohmann::json::array();
     for (const auto& s : snapshot.sessions) {
         j["sessions"].push_back({{"id", s.id}, {"name", s.name}, {"source", s.source},
@@ -98,9 +106,15 @@ void PrintText(const nlohmann::json& j) {
         std::cout << "extent       " << j["extent_min"].dump() << " .. " << j["extent_max"].dump()
                   << " m\n";
     }
+    const nlohmann::json& b = j["bytes"];
+    const auto mb = [&](const char* key) { return b[key].get<uint64_t>() / 1e6; };
     std::cout << "tiles        " << j["tiles"] << " of " << j["tile_size_m"] << " m ("
-              << j["tile_bytes"].get<uint64_t>() / 1e6 << " MB), " << j["tile_versions"]
-              << " versions kept\n"
+              << mb("fused_current") << " MB), " << j["tile_versions"]
+              << " fused versions kept (history from commit " << j["history_start_commit"]
+              << ")\n"
+              << "files        " << mb("fused_older") << " MB older fused, " << mb("layers")
+              << " MB session layers, " << mb("products") << " MB products, " << mb("catalog")
+              << " MB catalog\n"
               << "memory       " << j["memory_bytes"].get<size_t>() / 1e6 << " MB in RAM, "
               << j["disk_bytes"].get<uint64_t>() / 1e6 << " MB on disk\n"
               << "classes (occupied voxels):\n";

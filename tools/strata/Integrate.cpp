@@ -6,11 +6,13 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 #include "Alignment.hpp"
 #include "Commands.hpp"
 #include "MapAccess.hpp"
 #include "ScanSource.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::tools {
 
@@ -40,7 +42,40 @@ bool IsLas(const std::string& path) {
     return ext == ".las";
 }
 
-void Integrate(const IntegrateArgs& args, store::MapStore& map, bool existed) {
+// The integration rule of an existing map, with every flag the user gave checked against it: the
+// rule is fixed when the map is created, so a different value is an error naming the flag, the
+// map's value and the given one, before anything is written.
+integration::IntegrationConfig MapRule(const IntegrateArgs& args, const CLI::App& cmd,
+                                       const store::MapStore& map) {
+    const integration::IntegrationConfig& recorded = map.settings().integration;
+    const auto check = [&](const char* flag, bool differs, const std::string& ours,
+                           const std::string& given) {
+        if (cmd.count(flag) && differs) {
+            throw InvalidArgumentError(flag + (given.empty() ? "" : " " + given) + ": " + args.map +
+                                       " was built with " + ours +
+                                       " (the integration rule is fixed when a map is created; "
+                                       "integrate into a new map to change it)");
+        }
+    };
+    const auto text = [](double v) {
+        std::ostringstream os;
+        os << v;
+        return os.str();
+    };
+    check("--max-range", recorded.max_range_m != args.config.max_range_m,
+          "--max-range " + text(recorded.max_range_m), text(args.config.max_range_m));
+    check("--min-range", recorded.min_range_m != args.config.min_range_m,
+          "--min-range " + text(recorded.min_range_m), text(args.config.min_range_m));
+    check("--points-only", !recorded.points_only, "free space traced (no --points-only)", "");
+    check("--no-point-means", recorded.keep_point_means, "point means kept", "");
+    integration::IntegrationConfig config = recorded;
+    config.max_update_bytes = args.config.max_update_bytes;  // memory bounds, not the rule
+    config.dense_scratch_limit_bytes = args.config.dense_scratch_limit_bytes;
+    return config;
+}
+
+void Integrate(const IntegrateArgs& args, const integration::IntegrationConfig& config,
+               store::MapStore& map, bool existed) {
     const store::MapSettings& settings = map.settings();
     io::ReadOptions read_options;
     read_options.origin = settings.origin;
@@ -68,12 +103,13 @@ void Integrate(const IntegrateArgs& args, store::MapStore& map, bool existed) {
     std::cerr << "strata integrate: " << source.size() << " scans from " << source.Describe()
               << " into " << args.map << (existed ? "" : " (new)") << ", voxel "
               << settings.voxel_size_m << " m, tiles " << settings.tile_size_m() << " m, range ["
-              << args.config.min_range_m << ", " << args.config.max_range_m << "] m"
-              << (args.config.points_only ? ", points only" : "") << ", threads "
+              << config.min_range_m << ", " << config.max_range_m << "] m"
+              << (config.points_only ? ", points only" : "")
+              << (config.keep_point_means ? "" : ", no point means") << ", threads "
               << (args.threads > 0 ? std::to_string(args.threads) : "all") << "\n";
 
     const auto start = std::chrono::steady_clock::now();
-    store::SessionWriter writer(map, args.config, options);
+    store::SessionWriter writer(map, config, options);
     IntegrateScans(writer, source);
     const store::SessionRecord session = writer.Commit();
     const double seconds =
@@ -105,18 +141,21 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
                                     "--align)");
     }
     std::optional<store::MapStore> map;
+    integration::IntegrationConfig config = args.config;
     if (exists) {
         map.emplace(store::MapStore::Open(args.map, store::MapStore::Access::kWrite));
+        config = MapRule(args, cmd, *map);
         const double voxel = map->settings().voxel_size_m;
         if (cmd.count("--voxel") && std::abs(voxel - args.voxel) > 1e-12) {
-            throw std::invalid_argument(args.map + " has voxel size " + std::to_string(voxel) +
-                                        " m; --voxel " + std::to_string(args.voxel) +
-                                        " cannot change it");
+            throw InvalidArgumentError(args.map + " has voxel size " + std::to_string(voxel) +
+                                       " m; --voxel " + std::to_string(args.voxel) +
+                                       " cannot change it");
         }
     } else {
         store::StoreSettings settings;
         settings.voxel_size_m = args.voxel;
         settings.tile_size_m = args.tile_size;
+        settings.integration = args.config;  // recorded: every later session fuses alike
         if (!args.origin.empty()) {
             settings.origin = Eigen::Vector3d(args.origin[0], args.origin[1], args.origin[2]);
         } else if (!args.scans.empty() && IsLas(args.scans.front())) {
@@ -126,7 +165,7 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
         map.emplace(store::MapStore::Create(args.map, settings));
     }
     try {
-        Integrate(args, *map, exists);
+        Integrate(args, config, *map, exists);
     } catch (...) {
         // A map this command created holds nothing else: leave no empty map behind.
         if (!exists) {

@@ -1,4 +1,5 @@
 // strata check / strata gc: verify a map's files, remove what a crash left behind.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -16,7 +17,7 @@ void Check(const std::string& dir, bool json) {
         nlohmann::json j;
         j["map"] = dir;
         j["ok"] = report.ok();
-        j["tile_files"] = report.tile_versions;
+        j["files"] = report.files;
         j["problems"] = nlohmann::json::array();
         for (const auto& p : report.problems) {
             j["problems"].push_back({{"file", p.file}, {"problem", p.what}});
@@ -24,7 +25,7 @@ void Check(const std::string& dir, bool json) {
         j["unreferenced"] = report.unreferenced;
         std::cout << j.dump(2) << "\n";
     } else {
-        std::cout << dir << ": " << report.tile_versions << " tile files checked, "
+        std::cout << dir << ": " << report.files << " files checked, "
                   << report.problems.size() << " problems\n";
         for (const auto& p : report.problems) std::cout << "  " << p.file << ": " << p.what << "\n";
         if (!report.unreferenced.empty()) {
@@ -39,11 +40,32 @@ void Check(const std::string& dir, bool json) {
     }
 }
 
-void Gc(const std::string& dir) {
-    store::MapStore map = store::MapStore::Open(dir, store::MapStore::Access::kWrite);
-    const store::GcReport report = map.CollectGarbage();
+void Gc(const std::string& dir, const store::HistoryPolicy& policy) {
+    const bool drop = policy.keep_last > 0 || !policy.keep_since_utc.empty();
+    if (drop) policy.Validate();  // before the map is opened: a bad flag changes nothing
+    store::MapStore map = OpenMap(dir, store::MapStore::Access::kWrite);
+    store::GcReport report;
+    if (drop) report = map.DropHistory(policy);
+    const store::GcReport garbage = map.CollectGarbage();
+    report.removed.insert(report.removed.end(), garbage.removed.begin(), garbage.removed.end());
+    report.bytes += garbage.bytes;
     for (const auto& file : report.removed) std::cout << "removed " << file << "\n";
-    std::cout << report.removed.size() << " files, " << report.bytes / 1e6 << " MB freed\n";
+    std::cout << report.removed.size() << " files, " << report.bytes / 1e6
+              << " MB freed; history kept from commit " << map.HistoryStart() << "\n";
+}
+
+void Upgrade(const std::string& dir) {
+    if (!std::filesystem::exists(dir)) (void)OpenMap(dir);  // says how to create one
+    const int before = store::MapStore::FormatOf(dir);
+    if (before == store::MapStore::kFormatVersion) {
+        std::cout << dir << ": format " << before << " already, nothing to do\n";
+        return;
+    }
+    // Opening as the writer migrates in place: new files first, then one transaction.
+    const store::MapStore map = OpenMap(dir, store::MapStore::Access::kWrite);
+    std::cout << dir << ": format " << before << " -> " << map.settings().format_version
+              << " (" << map.TileFileCount() << " fused versions, "
+              << map.Latest().sessions.size() << " sessions)\n";
 }
 
 }  // namespace
@@ -58,9 +80,28 @@ void RegisterMaintenance(CLI::App& app) {
     check->add_flag("--json", *json, "Print JSON");
     check->callback([map, json] { Check(*map, *json); });
 
-    CLI::App* gc = app.add_subcommand("gc", "Remove files no commit references (crash leftovers)");
+    auto policy = std::make_shared<store::HistoryPolicy>();
+    CLI::App* gc = app.add_subcommand(
+        "gc", "Remove files nothing references (crash leftovers); drop old history on request");
+    gc->footer(
+        "Examples:\n"
+        "  strata gc city.strata                      # crash leftovers only\n"
+        "  strata gc city.strata --keep-last 10       # the snapshots of the last 10 commits\n"
+        "  strata gc city.strata --keep-since 2024-06-01\n"
+        "Dropping history removes old fused versions and products (--as-of an older session is\n"
+        "then refused); a session's layers stay until the session is removed.");
     gc->add_option("MAP", *map, "Map directory")->required();
-    gc->callback([map] { Gc(*map); });
+    gc->add_option("--keep-last", policy->keep_last, "Keep the snapshots of the last N commits");
+    gc->add_option("--keep-since", policy->keep_since_utc,
+                   "Keep the snapshots of every commit since this UTC date (and the one current "
+                   "then)");
+    gc->callback([map, policy] { Gc(*map, *policy); });
+
+    CLI::App* upgrade = app.add_subcommand(
+        "upgrade", "Migrate a map of an older format in place (any writing command does too)");
+    upgrade->footer("Crash-safe: killed at any moment, the map is the old format or the new one.");
+    upgrade->add_option("MAP", *map, "Map directory")->required();
+    upgrade->callback([map] { Upgrade(*map); });
 }
 
 }  // namespace strata::tools

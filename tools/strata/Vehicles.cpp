@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
@@ -38,18 +39,23 @@ std::vector<Eigen::Vector3d> Origins(const store::MapStore& map, const store::Sn
     return origins;
 }
 
-store::VehicleRecord Record(const vehicles::Vehicle& v) {
-    store::VehicleRecord r;
-    r.vehicle_id = v.id;
-    r.center = v.Center();
-    r.size = v.Size();
-    r.yaw_deg = v.YawDeg();
-    r.source = vehicles::SourceName(v.source);
-    r.voxels = v.voxels;
-    r.cleared_voxels = v.cleared_voxels;
-    r.refilled_cells = v.refilled_cells;
-    r.refused_cells = v.refused_cells;
-    return r;
+// One row of the vehicles view (docs/store.md, "Products"; meaning of each key: docs/vehicles.md).
+std::string VehicleRow(const vehicles::Vehicle& v) {
+    const Eigen::Vector3d c = v.Center(), size = v.Size();
+    return nlohmann::json{{"vehicle_id", v.id},
+                          {"center_x", c.x()},
+                          {"center_y", c.y()},
+                          {"center_z", c.z()},
+                          {"length_m", size.x()},
+                          {"width_m", size.y()},
+                          {"height_m", size.z()},
+                          {"yaw_deg", v.YawDeg()},
+                          {"source", vehicles::SourceName(v.source)},
+                          {"voxels", v.voxels},
+                          {"cleared_voxels", v.cleared_voxels},
+                          {"refilled_cells", v.refilled_cells},
+                          {"refused_cells", v.refused_cells}}
+        .dump();
 }
 
 // Median ground height of the vehicles (0 without any): where the picture's cut is measured from.
@@ -107,13 +113,15 @@ void Run(VehiclesArgs& args) {
         PrintSummary(result, map);
     }
     if (save) {
-        std::vector<store::VehicleRecord> records;
-        for (const vehicles::Vehicle& v : result.vehicles) records.push_back(Record(v));
-        const int64_t commit =
-            map.CommitEdit("vehicles", voxels, vehicles::VehicleGrids(result), records);
+        store::ProductCommit product;
+        product.kind = "vehicles";
+        product.grids = vehicles::VehicleGrids(result);
+        product.edited = &voxels;
+        for (const vehicles::Vehicle& v : result.vehicles) product.rows.push_back(VehicleRow(v));
+        const int64_t commit = map.CommitProduct(product);
         (args.json ? std::cerr : std::cout)
             << "stored the cleaned map, the vehicle_cleared and vehicle_refilled grids and "
-            << records.size() << " vehicles (commit " << commit << ")\n";
+            << product.rows.size() << " vehicles (commit " << commit << ")\n";
     }
 }
 

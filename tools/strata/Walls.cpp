@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
@@ -27,20 +28,24 @@ struct WallsArgs {
     bool no_save = false;
 };
 
-store::WallRecord Record(const walls::Wall& w) {
-    store::WallRecord r;
-    r.wall_id = w.id;
-    r.center = w.centroid;
-    r.normal = w.normal;
-    r.slant_deg = w.slant_deg;
-    r.uncertainty_deg = w.uncertainty_deg;
-    r.lean_azimuth_deg = w.lean_azimuth_deg;
-    r.area_m2 = w.area_m2;
-    r.rms_m = w.rms_m;
-    r.length_m = w.length_m;
-    r.height_m = w.height_m;
-    r.inliers = w.inliers;
-    return r;
+// One row of the walls view (docs/store.md, "Products"; meaning of each key: docs/walls.md).
+std::string WallRow(const walls::Wall& w) {
+    return nlohmann::json{{"wall_id", w.id},
+                          {"center_x", w.centroid.x()},
+                          {"center_y", w.centroid.y()},
+                          {"center_z", w.centroid.z()},
+                          {"normal_x", w.normal.x()},
+                          {"normal_y", w.normal.y()},
+                          {"normal_z", w.normal.z()},
+                          {"slant_deg", w.slant_deg},
+                          {"uncertainty_deg", w.uncertainty_deg},
+                          {"lean_azimuth_deg", w.lean_azimuth_deg},
+                          {"area_m2", w.area_m2},
+                          {"rms_m", w.rms_m},
+                          {"length_m", w.length_m},
+                          {"height_m", w.height_m},
+                          {"inliers", w.inliers}}
+        .dump();
 }
 
 void PrintSummary(const walls::WallResult& result, const store::MapStore& map) {
@@ -99,11 +104,13 @@ void Run(const WallsArgs& args) {
         PrintSummary(result, map);
     }
     if (save) {
-        std::vector<store::WallRecord> records;
-        for (const walls::Wall& w : result.walls) records.push_back(Record(w));
-        const int64_t commit = map.CommitProducts("walls", walls::WallGrids(result), records);
+        store::ProductCommit product;
+        product.kind = "walls";
+        product.grids = walls::WallGrids(result);
+        for (const walls::Wall& w : result.walls) product.rows.push_back(WallRow(w));
+        const int64_t commit = map.CommitProduct(product);
         (args.json ? std::cerr : std::cout)
-            << "stored slant_deg and wall_id grids and " << records.size()
+            << "stored slant_deg and wall_id grids and " << product.rows.size()
             << " walls in the map (commit " << commit << ")\n";
     }
 }

@@ -30,25 +30,26 @@ struct SessionOptions {
 struct WriterStats {
     size_t tiles_loaded = 0;   ///< read from the map (or back from an eviction)
     size_t tiles_evicted = 0;  ///< moved out of memory to honour the budget
-    size_t tiles_written = 0;  ///< tile files written, evictions included
-    uint64_t bytes_written = 0;
+    size_t tiles_written = 0;  ///< fused versions written, evictions included
+    size_t layers_written = 0;  ///< layer files of this session written, evictions included
+    uint64_t bytes_written = 0;  ///< fused and layer files together
     size_t peak_memory_bytes = 0;  ///< largest working set seen (grids of loaded tiles)
     double commit_seconds = 0.0;
 };
 
 /// @brief Integrates one session into a map opened for writing, tile by tile, and commits it:
-/// the touched tiles' new versions are written (temporary file, fsync, rename, directory fsync),
-/// then recorded with the session and its scans in one SQLite transaction. Untouched tiles are
-/// not rewritten. Until Commit returns, the map on disk is unchanged for every reader; a writer
-/// destroyed without committing removes the files it wrote.
-///
-/// Besides the fused grids, each touched tile gets this session's layers
-/// `session_<id>_occupied` / `session_<id>_free`: the voxels whose log-odds over this session's
-/// scans alone ended above / at or below zero.
+/// for every touched tile a new fused version (`fN.vdb`) and this session's layers (`sS.vdb`:
+/// `session_<id>_occupied` / `session_<id>_free`, the voxels whose log-odds over this session's
+/// scans alone ended above / at or below zero) are written (temporary file, fsync, rename,
+/// directory fsync), then recorded with the session and its scans in one SQLite transaction.
+/// Nothing else is written: the cost follows the session, not the map's age. Until Commit
+/// returns the map on disk is unchanged for every reader; a writer destroyed without committing
+/// removes the files it wrote.
 class SessionWriter {
 public:
-    /// @throw std::logic_error when the store is not open for writing; std::invalid_argument on
-    /// an invalid config.
+    /// @throw InvalidArgumentError when the store is not open for writing, on an invalid config,
+    /// or when `config` differs from the integration rule the map was created with (naming the
+    /// field, the map's value and the given one).
     SessionWriter(MapStore& store, const integration::IntegrationConfig& config,
                   SessionOptions options);
     ~SessionWriter();

@@ -1,5 +1,6 @@
-// The viewer's only use of the map store (ViewSource.hpp): written against MapStore's format-4
-// API (Latest / AsOf / ReadTile / Walls / Vehicles / ChangeSets / SessionHistory).
+// The viewer's only use of the map store (ViewSource.hpp): snapshots pinned from MapStore (format
+// 5), tiles read through store::TileReader (fused grids, each session's layers, the walls and
+// vehicles products), and the analyses' rows as the store keeps them (ProductHistory).
 #include "ViewSource.hpp"
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "strata/change/MapObserver.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/store/MapStore.hpp"
+#include "strata/store/TileReader.hpp"
 #include "strata/vehicles/Vehicles.hpp"
 #include "strata/walls/WallReport.hpp"
 
@@ -33,45 +35,97 @@ json SessionJson(const store::SessionRecord& s, int64_t removed_by) {
             {"notes", s.notes},   {"commit", s.commit},       {"removed_by_commit", removed_by}};
 }
 
-json WallJson(const store::WallRecord& w) {
-    return {{"commit", w.commit},
-            {"wall_id", w.wall_id},
-            {"center", Vec(w.center)},
-            {"normal", Vec(w.normal)},
-            {"slant_deg", w.slant_deg},
-            {"uncertainty_deg", w.uncertainty_deg},
-            {"lean_azimuth_deg", w.lean_azimuth_deg},
-            {"area_m2", w.area_m2},
-            {"rms_m", w.rms_m},
-            {"length_m", w.length_m},
-            {"height_m", w.height_m},
-            {"inliers", w.inliers}};
+// A product row as the analysis stored it (its own JSON object), or FormatError naming it.
+json RowObject(const store::MapStore& store, const std::string& kind, const store::ProductRow& r) {
+    json j = json::parse(r.json, nullptr, false);
+    if (!j.is_object()) {
+        throw FormatError(store.dir().string() + ": " + kind + " row " + std::to_string(r.id) +
+                          " is not a JSON object");
+    }
+    return j;
 }
 
-json VehicleJson(const store::VehicleRecord& v) {
-    return {{"commit", v.commit},
-            {"vehicle_id", v.vehicle_id},
-            {"center", Vec(v.center)},
-            {"size", Vec(v.size)},
-            {"yaw_deg", v.yaw_deg},
-            {"source", v.source},
-            {"voxels", v.voxels},
-            {"cleared_voxels", v.cleared_voxels},
-            {"refilled_cells", v.refilled_cells},
-            {"refused_cells", v.refused_cells}};
+json XYZ(const json& row, const std::string& x, const std::string& y, const std::string& z) {
+    return json::array({row.value(x, 0.0), row.value(y, 0.0), row.value(z, 0.0)});
+}
+
+// The rows `strata walls` stores (tools/strata/Walls.cpp), in the shape the page reads.
+json WallJson(const json& w, int64_t commit) {
+    return {{"commit", commit},
+            {"wall_id", w.value("wall_id", 0)},
+            {"center", XYZ(w, "center_x", "center_y", "center_z")},
+            {"normal", XYZ(w, "normal_x", "normal_y", "normal_z")},
+            {"slant_deg", w.value("slant_deg", 0.0)},
+            {"uncertainty_deg", w.value("uncertainty_deg", 0.0)},
+            {"lean_azimuth_deg", w.value("lean_azimuth_deg", 0.0)},
+            {"area_m2", w.value("area_m2", 0.0)},
+            {"rms_m", w.value("rms_m", 0.0)},
+            {"length_m", w.value("length_m", 0.0)},
+            {"height_m", w.value("height_m", 0.0)},
+            {"inliers", w.value("inliers", 0)}};
+}
+
+// The rows `strata vehicles` stores (tools/strata/Vehicles.cpp).
+json VehicleJson(const json& v, int64_t commit) {
+    return {{"commit", commit},
+            {"vehicle_id", v.value("vehicle_id", 0)},
+            {"center", XYZ(v, "center_x", "center_y", "center_z")},
+            {"size", XYZ(v, "length_m", "width_m", "height_m")},
+            {"yaw_deg", v.value("yaw_deg", 0.0)},
+            {"source", v.value("source", "")},
+            {"voxels", v.value("voxels", 0)},
+            {"cleared_voxels", v.value("cleared_voxels", 0)},
+            {"refilled_cells", v.value("refilled_cells", 0)},
+            {"refused_cells", v.value("refused_cells", 0)}};
+}
+
+// A saved change set (`strata diff --save`, tools/strata/Diff.cpp): its sides and counts.
+struct ChangeSetRow {
+    int64_t id = 0;
+    int64_t commit = 0;
+    std::string from, to;
+    size_t added_voxels = 0, removed_voxels = 0, objects = 0;
+    json report;
+};
+
+ChangeSetRow ChangeSetOf(const json& j, const store::ProductRow& r) {
+    ChangeSetRow c;
+    c.id = r.id;
+    c.commit = r.commit;
+    c.from = j.value("from_side", "");
+    c.to = j.value("to_side", "");
+    c.added_voxels = j.value("added_voxels", size_t{0});
+    c.removed_voxels = j.value("removed_voxels", size_t{0});
+    c.objects = j.value("objects", size_t{0});
+    c.report = j.value("report", json());
+    return c;
 }
 
 // The row of a saved change set; its counts are in the report (added_voxels, removed_voxels,
 // unknown_voxels, objects).
-json ChangeSetJson(const store::ChangeSetRecord& r) {
-    return {
-        {"id", r.id},     {"commit", r.commit}, {"created_utc", r.created_utc},
-        {"from", r.from}, {"to", r.to},         {"report", json::parse(r.report, nullptr, false)}};
+json ChangeSetJson(const ChangeSetRow& r, const std::string& created_utc) {
+    return {{"id", r.id},     {"commit", r.commit}, {"created_utc", created_utc},
+            {"from", r.from}, {"to", r.to},         {"report", r.report}};
+}
+
+// The rows of `kind` a reader of commit `commit` sees: those of its newest commit of `kind` at
+// or before `commit` (a later commit of a kind replaces the earlier one's rows).
+std::vector<store::ProductRow> RowsAt(const store::MapStore& store, const std::string& kind,
+                                      int64_t commit) {
+    std::vector<store::ProductRow> rows = store.ProductHistory(kind);
+    int64_t newest = 0;
+    for (const store::ProductRow& r : rows) {
+        if (r.commit <= commit) newest = std::max(newest, r.commit);
+    }
+    rows.erase(std::remove_if(rows.begin(), rows.end(),
+                              [&](const store::ProductRow& r) { return r.commit != newest; }),
+               rows.end());
+    return rows;
 }
 
 template <typename GridT>
-typename GridT::ConstPtr Product(const store::Tile& tile, const char* name) {
-    for (const openvdb::GridBase::Ptr& grid : tile.products) {
+typename GridT::ConstPtr Product(const openvdb::GridPtrVec& grids, const char* name) {
+    for (const openvdb::GridBase::Ptr& grid : grids) {
         if (grid->getName() == name) return openvdb::GridBase::constGrid<GridT>(grid);
     }
     return nullptr;
@@ -124,24 +178,29 @@ struct ViewSource::Impl {
     MapFacts facts;
     std::vector<store::Snapshot> pinned;  ///< parallel to snapshots
     std::vector<ViewSnapshot> snapshots;
+    /// Reads tiles of each pinned snapshot (parallel to it), sharing one cache-free file reader:
+    /// the service keeps its own cache of what it made from the grids.
+    std::vector<store::TileReader> readers;
     json sessions = json::array();
     json walls = json::array();
     json vehicles = json::array();
     json change_sets = json::array();
-    std::vector<store::ChangeSetRecord> change_set_records;
-    std::map<TileRef, store::TileVersion> versions;  ///< every tile file a snapshot names
-    mutable std::mutex catalog;  ///< one catalog reader at a time (change queries)
+    std::vector<ChangeSetRow> change_set_records;
+    std::map<TileRef, size_t> versions;  ///< every fused version a snapshot names: its reader
+    mutable std::mutex catalog;          ///< one catalog reader at a time (change queries)
 
     void Pin(store::Snapshot snapshot, int64_t as_of_session) {
         ViewSnapshot view{snapshot.commit, as_of_session, {}, {}};
         for (const store::TileVersion& v : snapshot.tiles) {
             const TileRef ref{v.key.x, v.key.y, v.version};
             view.tiles.push_back(ref);
-            versions.emplace(ref, v);
+            versions.emplace(ref, pinned.size());
         }
         for (const store::SessionRecord& s : snapshot.sessions) view.sessions.push_back(s.id);
         std::sort(view.sessions.begin(), view.sessions.end());
         snapshots.push_back(std::move(view));
+        readers.push_back(readers.empty() ? store::TileReader(store, snapshot, 0)
+                                          : readers.front().At(snapshot));
         pinned.push_back(std::move(snapshot));
     }
 
@@ -151,7 +210,13 @@ struct ViewSource::Impl {
         static const std::regex session(R"(session (\d+))"), as_of(R"(map as of session (\d+))");
         std::smatch m;
         if (std::regex_match(name, m, session)) return observer.Session(std::stoll(m[1]));
-        if (std::regex_match(name, m, as_of)) return observer.Map(store.AsOf(std::stoll(m[1])));
+        if (std::regex_match(name, m, as_of)) {
+            const int64_t id = std::stoll(m[1]);
+            for (size_t i = 0; i < pinned.size(); ++i) {
+                if (snapshots[i].as_of_session == id) return observer.Map(pinned[i]);
+            }
+            return std::nullopt;  // a snapshot this view did not pin (or gc dropped)
+        }
         if (name == "map (newest)") {
             for (const store::Snapshot& s : pinned) {
                 if (s.commit == saved_at) return observer.Map(s);
@@ -179,8 +244,11 @@ std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::str
     const int64_t as_of_id = as_of.empty() ? 0 : SessionNamed(s.store, as_of);
     s.Pin(as_of.empty() ? s.store.Latest() : s.store.AsOf(as_of_id), as_of_id);
     const int64_t commit = s.snapshots.front().commit;
-    for (const int64_t id : std::vector<int64_t>(s.snapshots.front().sessions)) {
-        s.Pin(s.store.AsOf(id), id);
+    // The map right after each session, as far as the map keeps its history (strata gc).
+    const int64_t history_start = s.store.HistoryStart();
+    for (const store::SessionRecord& session :
+         std::vector<store::SessionRecord>(s.pinned.front().sessions)) {
+        if (session.commit >= history_start) s.Pin(s.store.AsOf(session.id), session.id);
     }
     // Rows newer than the pinned commit belong to a state of the map this viewer does not show.
     for (const auto& [session, removed_by] : s.store.SessionHistory()) {
@@ -188,16 +256,17 @@ std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::str
             s.sessions.push_back(SessionJson(session, removed_by > commit ? 0 : removed_by));
         }
     }
-    for (const store::WallRecord& w : s.store.Walls()) {
-        if (w.commit <= commit) s.walls.push_back(WallJson(w));
+    for (const store::ProductRow& r : RowsAt(s.store, "walls", commit)) {
+        s.walls.push_back(WallJson(RowObject(s.store, "walls", r), r.commit));
     }
-    for (const store::VehicleRecord& v : s.store.Vehicles()) {
-        if (v.commit <= commit) s.vehicles.push_back(VehicleJson(v));
+    for (const store::ProductRow& r : RowsAt(s.store, "vehicles", commit)) {
+        s.vehicles.push_back(VehicleJson(RowObject(s.store, "vehicles", r), r.commit));
     }
-    for (const store::ChangeSetRecord& r : s.store.ChangeSets()) {
+    for (const store::ProductRow& r : s.store.ProductHistory("change_sets")) {
         if (r.commit > commit) continue;
-        s.change_sets.push_back(ChangeSetJson(r));
-        s.change_set_records.push_back(r);
+        const ChangeSetRow row = ChangeSetOf(RowObject(s.store, "change_sets", r), r);
+        s.change_sets.push_back(ChangeSetJson(row, r.time_utc));
+        s.change_set_records.push_back(row);
     }
     return std::shared_ptr<ViewSource>(new ViewSource(std::move(impl)));
 }
@@ -215,19 +284,29 @@ TileGrids ViewSource::ReadTile(const TileRef& ref) const {
         throw NotFoundError("tile " + std::to_string(ref.x) + "_" + std::to_string(ref.y) + " v" +
                             std::to_string(ref.version) + " is in no snapshot of this view");
     }
-    const store::Tile tile = impl_->store.ReadTile(it->second);
-    TileGrids grids;
-    grids.occupancy = tile.fused.occupancy;
-    grids.label = tile.fused.label;
-    grids.endpoints = tile.fused.endpoints;
-    for (const store::SessionLayer& layer : tile.layers) {
-        grids.sessions.emplace_back(layer.session, layer.occupied);
-        grids.sessions_free.emplace_back(layer.session, layer.free);
+    const store::TileReader& reader = impl_->readers[it->second];
+    const store::TileKey key{ref.x, ref.y};
+    const std::shared_ptr<const core::VoxelMap> fused = reader.Fused(key);
+    if (!fused) {
+        throw NotFoundError("tile " + std::to_string(ref.x) + "_" + std::to_string(ref.y) +
+                            " has no fused grids");
     }
-    grids.slant_deg = Product<openvdb::FloatGrid>(tile, walls::product_names::kSlantDeg);
-    grids.wall_id = Product<openvdb::Int32Grid>(tile, walls::product_names::kWallId);
-    grids.cleared = Product<openvdb::Int32Grid>(tile, vehicles::grid_names::kCleared);
-    grids.refilled = Product<openvdb::FloatGrid>(tile, vehicles::grid_names::kRefilled);
+    TileGrids grids;
+    grids.occupancy = fused->occupancy;
+    grids.label = fused->label;
+    grids.endpoints = fused->endpoints;
+    for (const int64_t session : impl_->snapshots[it->second].sessions) {
+        if (const auto layer = reader.Layers(key, session)) {
+            grids.sessions.emplace_back(session, layer->occupied);
+            grids.sessions_free.emplace_back(session, layer->free);
+        }
+    }
+    const openvdb::GridPtrVec wall_grids = reader.Products(key, "walls");
+    const openvdb::GridPtrVec car_grids = reader.Products(key, "vehicles");
+    grids.slant_deg = Product<openvdb::FloatGrid>(wall_grids, walls::product_names::kSlantDeg);
+    grids.wall_id = Product<openvdb::Int32Grid>(wall_grids, walls::product_names::kWallId);
+    grids.cleared = Product<openvdb::Int32Grid>(car_grids, vehicles::grid_names::kCleared);
+    grids.refilled = Product<openvdb::FloatGrid>(car_grids, vehicles::grid_names::kRefilled);
     return grids;
 }
 
@@ -254,10 +333,10 @@ ChangeMasks ViewSource::DiffSessions(int64_t a, int64_t b) const {
 std::optional<ChangeMasks> ViewSource::ChangeSetVoxels(int64_t id) const {
     const auto& records = impl_->change_set_records;
     const auto it = std::find_if(records.begin(), records.end(),
-                                 [&](const store::ChangeSetRecord& r) { return r.id == id; });
+                                 [&](const ChangeSetRow& r) { return r.id == id; });
     if (it == records.end()) throw NotFoundError("no change set " + std::to_string(id));
-    const json report = json::parse(it->report, nullptr, false);
-    if (report.is_discarded()) return std::nullopt;
+    const json& report = it->report;
+    if (!report.is_object()) return std::nullopt;
     const std::lock_guard<std::mutex> lock(impl_->catalog);
     change::MapObserver observer(impl_->store);
     const auto before = impl_->Side(it->from, it->commit, observer);
