@@ -15,6 +15,8 @@ struct SessionsConfig {
     size_t sessions = 50;
     double voxel_m = 0.2;
     double tile_m = 64.0;
+    /// Session N's commit CPU time over session 2's, at most (issue 17's target: 1.2).
+    double max_time_ratio = 1.2;
 };
 
 /// Sessions 1..N of the same scans into one map: bytes and time per commit, disk use, the cost of

@@ -13,6 +13,9 @@
 #          between TBB threads is a report.
 #   STRATA_BUILD_JOBS=2  build parallelism   STRATA_TEST_JOBS=2  ctest -j
 #   STRATA_SANITIZE_TARGETS="test_store"  build only these programs; pass the matching -R Store
+#   STRATA_SANITIZE_MIN_TESTS=N  fail when fewer than N tests are selected (.ci/run sets it;
+#          default: $tsan_min_tests for tsan without arguments, else 1). With no test selected
+#          ctest itself fails (--no-tests=error).
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
 # Tests read STRATA_SANITIZER (address or thread, set here) to shrink what is too slow there.
 set -euo pipefail
@@ -37,6 +40,10 @@ tsan_targets=(test_integration test_store test_sim test_change test_vehicles tes
 tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection|RayCheck|ClearVehicles)\.'
 tsan_tests+='|^OctomapAgreement\.Synthetic|^RegistrationIcp\.Recovers'
 tsan_tests+='|^Store\.(SessionsEqualInMemory|OneWriterAtATime|ReadersSeeWholeCommits)'
+# What the TSan selection held on 2026-12-02 (docs/reliability.md, "Sanitizers"): a filter or a
+# build change that drops tests fails the run instead of passing on fewer. Raise it when tests
+# are added.
+tsan_min_tests=44
 
 if ! command -v clang++ >/dev/null; then
   echo "sanitize.sh: clang++ not found (tools/setup.sh installs it)" >&2
@@ -113,10 +120,19 @@ export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$reports/t
 TSAN_OPTIONS+=":suppressions=$root/tools/tsan-suppressions.txt"
 # Programs left unbuilt on purpose show up in ctest as <program>_NOT_BUILT.
 [[ -n ${STRATA_SANITIZE_TARGETS:-} ]] && filter+=(-E _NOT_BUILT)
+min_tests=1
+[[ $mode == tsan && $# -eq 0 && -z ${STRATA_SANITIZE_TARGETS:-} ]] && min_tests=$tsan_min_tests
+min_tests=${STRATA_SANITIZE_MIN_TESTS:-$min_tests}
+selected=$(ctest --test-dir "$build" -N "${filter[@]}" "$@" | grep -c '^ *Test *#' || true)
+echo "sanitize.sh: $selected tests selected (at least $min_tests expected)"
+if ((selected < min_tests)); then
+  echo "sanitize.sh: only $selected tests selected, expected at least $min_tests" >&2
+  exit 1
+fi
 test_start=$(date +%s)
 status=0
-ctest --test-dir "$build" --output-on-failure -j "${STRATA_TEST_JOBS:-$(nproc)}" \
-  "${filter[@]}" "$@" || status=$?
+ctest --test-dir "$build" --output-on-failure --no-tests=error \
+  -j "${STRATA_TEST_JOBS:-$(nproc)}" "${filter[@]}" "$@" || status=$?
 end=$(date +%s)
 echo "sanitize.sh: $mode tests took $((end - test_start)) s, $((end - start)) s in all"
 if compgen -G "$reports/*" >/dev/null; then

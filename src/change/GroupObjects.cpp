@@ -1,11 +1,12 @@
-// Changed voxels -> objects: breadth-first search over the voxels within the gap tolerance, using
-// an index grid as the sparse lookup, then per-object statistics.
+// Changed voxels -> objects: the voxels grouped within the gap tolerance (geometry::GroupVoxels),
+// then per-object statistics.
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <deque>
+#include <utility>
 
 #include "strata/change/ChangeDetection.hpp"
+#include "strata/geometry/Grouping.hpp"
 
 namespace strata::change {
 namespace {
@@ -88,38 +89,8 @@ std::vector<ObjectVoxels> GroupObjects(const openvdb::BoolGrid& mask, ChangeKind
             for (auto it = box.begin(); it; ++it) coords.push_back(*it);
         }
     }
-    // Index of every voxel, as a sparse lookup shaped like the mask.
-    openvdb::Int32Tree index(-1);
-    {
-        openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(index);
-        for (size_t i = 0; i < coords.size(); ++i) acc.setValue(coords[i], static_cast<int>(i));
-    }
-    openvdb::tree::ValueAccessor<const openvdb::Int32Tree> acc(index);
-    const int r = std::max(0, gap_voxels) + 1;
-    std::vector<bool> seen(coords.size(), false);
     std::vector<ObjectVoxels> objects;
-    std::deque<int> queue;
-    for (size_t seed = 0; seed < coords.size(); ++seed) {
-        if (seen[seed]) continue;
-        std::vector<Coord> voxels;
-        seen[seed] = true;
-        queue.push_back(static_cast<int>(seed));
-        while (!queue.empty()) {
-            const Coord c = coords[queue.front()];
-            queue.pop_front();
-            voxels.push_back(c);
-            for (int dx = -r; dx <= r; ++dx) {
-                for (int dy = -r; dy <= r; ++dy) {
-                    for (int dz = -r; dz <= r; ++dz) {
-                        int j = -1;
-                        if (acc.probeValue(c.offsetBy(dx, dy, dz), j) && !seen[j]) {
-                            seen[j] = true;
-                            queue.push_back(j);
-                        }
-                    }
-                }
-            }
-        }
+    for (std::vector<Coord>& voxels : geometry::GroupVoxels(coords, std::max(0, gap_voxels) + 1)) {
         ObjectVoxels group;
         group.object = Describe(voxels, kind, voxel_size, labels);
         group.voxels = std::move(voxels);

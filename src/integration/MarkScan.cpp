@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "RayMarking.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::integration::detail {
 namespace {
@@ -242,7 +243,7 @@ void RequireSparseMarkingFits(const PreparedScan& scan, const IntegrationConfig&
                           "than %.1f GB of tree nodes, the most one scan may add: use a larger "
                           "voxel size or a shorter max range",
                           leaves.size(), s, budget / 1e9);
-            throw std::runtime_error(text);
+            throw RefusedError(text);
         }
     }
 }

@@ -6,8 +6,8 @@
 #include <set>
 
 #include "strata/core/Labels.hpp"
+#include "strata/geometry/Clustering.hpp"
 #include "strata/vehicles/VehicleStages.hpp"
-#include "strata/walls/Clustering.hpp"
 
 namespace strata::vehicles {
 
@@ -159,7 +159,7 @@ ObjectSet FindObjects(const core::VoxelMap& map, const GroundField& ground, Vehi
         }
     }
     const double eps = std::max(1.75, 1.0 + config.gap_m / map.voxel_size);
-    const std::vector<int> cluster = walls::Dbscan(voxels, eps, 1);
+    const std::vector<int> cluster = geometry::Dbscan(voxels, eps, 1);
     std::map<int, std::vector<openvdb::Coord>> groups;
     for (size_t i = 0; i < voxels.size(); ++i) groups[cluster[i]].push_back(voxels[i]);
     for (auto& [id, group] : groups) {

@@ -3,9 +3,13 @@
 #include <cmath>
 #include <vector>
 
+#include "strata/geometry/PlaneFit.hpp"
 #include "strata/walls/Walls.hpp"
 
 namespace strata::walls {
+
+using geometry::RansacPlane;
+using geometry::RansacResult;
 
 std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
                                            const columns::ColumnGrid& window, int radius,

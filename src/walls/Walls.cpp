@@ -10,9 +10,27 @@
 #include <optional>
 #include <stdexcept>
 
-#include "strata/walls/Clustering.hpp"
+#include "strata/geometry/Clustering.hpp"
+#include "strata/geometry/PlaneFit.hpp"
 
 namespace strata::walls {
+
+using geometry::Dbscan;
+using geometry::FitPlane;
+using geometry::KMeans;
+using geometry::kNoise;
+using geometry::Plane;
+using geometry::PlaneFit;
+using geometry::RansacPlane;
+using geometry::RansacResult;
+using geometry::RefinePlane;
+using geometry::XyEigenRatio;
+
+int PartsFor(size_t n, int divisor) {
+    if (divisor < 1) throw InvalidArgumentError("K-means divisor must be >= 1");
+    return std::max(1, static_cast<int>(n / static_cast<size_t>(divisor)));
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
+#include <typeinfo>
 
 namespace strata::fuzz {
 namespace {
@@ -77,6 +78,16 @@ fs::path WriteInput(const uint8_t* data, size_t size, const std::string& name) {
 void Expect(bool ok, const char* what) {
     if (ok) return;
     std::fprintf(stderr, "strata fuzz: contract broken: %s\n", what);
+    std::abort();
+}
+
+void RejectUnexpected(const std::exception& e) {
+    const char* strict = std::getenv("STRATA_FUZZ_STRICT_KINDS");
+    const bool legacy =
+        typeid(e) == typeid(std::runtime_error) || typeid(e) == typeid(std::invalid_argument);
+    if (legacy && (strict == nullptr || std::strcmp(strict, "1") != 0)) return;
+    std::fprintf(stderr, "strata fuzz: %s thrown, not a strata::Error kind: %s\n", typeid(e).name(),
+                 e.what());
     std::abort();
 }
 

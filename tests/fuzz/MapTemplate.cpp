@@ -35,7 +35,8 @@ std::string CreateSmallMap(const std::filesystem::path& dir) {
     return snapshot.tiles.front().file;
 }
 
-void ReadWholeMap(const std::filesystem::path& dir) {
+std::optional<store::CheckReport> ReadWholeMap(const std::filesystem::path& dir) {
+    std::optional<store::CheckReport> report;
     Refusal([&] {
         const store::MapStore map = store::MapStore::Open(dir, store::MapStore::Access::kRead);
         const store::Snapshot snapshot = map.Latest();
@@ -46,8 +47,9 @@ void ReadWholeMap(const std::filesystem::path& dir) {
             Refusal([&] { (void)map.ReadLayer(layer); });
         }
         Refusal([&] { (void)map.LoadMap(snapshot); });
-        (void)map.Check();
+        report = map.Check();
     });
+    return report;
 }
 
 }  // namespace strata::fuzz

@@ -4,7 +4,10 @@
 // the source of its seed (the bytes of one tile file).
 
 #include <filesystem>
+#include <optional>
 #include <string>
+
+#include "strata/store/MapStore.hpp"
 
 namespace strata::fuzz {
 
@@ -13,7 +16,8 @@ namespace strata::fuzz {
 [[nodiscard]] std::string CreateSmallMap(const std::filesystem::path& dir);
 
 /// @brief Reads a map the way `strata info/export/check` do: Open, Latest, every tile, LoadMap
-/// and Check. A std::exception anywhere is an accepted refusal; anything else is a finding.
-void ReadWholeMap(const std::filesystem::path& dir);
+/// and Check. A refusal (fuzz::Refusal) anywhere is accepted; anything else is a finding.
+/// Returns Check()'s report when the map opened and Check ran to the end.
+[[nodiscard]] std::optional<store::CheckReport> ReadWholeMap(const std::filesystem::path& dir);
 
 }  // namespace strata::fuzz

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "RealData.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/core/Scan.hpp"
 
@@ -295,9 +296,6 @@ inline void ExpectLasPoints(const core::Scan& scan, const Eigen::Vector3d& origi
 
 inline std::string DataDir() { return STRATA_DATA_DIR; }
 
-#define STRATA_REQUIRE_DATA(sub)                                                     \
-    if (!fs::exists(fs::path(DataDir()) / sub)) {                                    \
-        GTEST_SKIP() << "real data " << (fs::path(DataDir()) / sub) << " is absent"; \
-    }
+#define STRATA_REQUIRE_DATA(sub) STRATA_SKIP_WITHOUT_DATA(fs::path(DataDir()) / sub)
 
 }  // namespace strata::io::test_files

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "RealData.hpp"
 #include "CoarseSearch.hpp"
 #include "RealPairs.hpp"
 #include "strata/io/PointCloudReaders.hpp"
@@ -43,7 +44,7 @@ Halves Split(const std::vector<Eigen::Vector3d>& points) {
 }
 
 TEST(RegistrationRealDataOuster, HalvesOfOneSweepAlignAtTheIdentity) {
-    if (!fs::exists(Dir() / kScans[0])) GTEST_SKIP() << Dir() << " not found";
+    STRATA_SKIP_WITHOUT_DATA(Dir() / kScans[0]);
     const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
     for (const char* name : kScans) {
         const Halves h = Split(io::ReadPcd(Dir() / name).points);
@@ -83,7 +84,7 @@ Found SearchAndRefine(const RawPointToPlane& raw, const std::vector<Eigen::Vecto
 }
 
 TEST(RegistrationRealDataOuster, TheTwoScansAreOfTwoPlacesAndRegistrationRefusesThem) {
-    if (!fs::exists(Dir() / kScans[1])) GTEST_SKIP() << Dir() << " not found";
+    STRATA_SKIP_WITHOUT_DATA(Dir() / kScans[1]);
     const std::vector<Eigen::Vector3d> a = io::ReadPcd(Dir() / kScans[0]).points;
     const std::vector<Eigen::Vector3d> b = io::ReadPcd(Dir() / kScans[1]).points;
     // Control: the search finds half of scan A moved by a known transform.

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "RealData.hpp"
 #include "RealPairs.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/registration/SessionCloud.hpp"
@@ -49,7 +50,7 @@ void Report(const std::string& what, const PoseGap& g) {
 
 TEST(RegistrationRealData, Kitti00FramesLandOnTheRawPointOptimumAndAmongTheStereoReferences) {
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "kitti00";
-    if (!fs::exists(dir / "poses_sptam.txt")) GTEST_SKIP() << dir << " (stereo poses) not found";
+    STRATA_SKIP_WITHOUT_DATA(dir / "poses_sptam.txt");
     const Kitti00 k = LoadKitti00(dir);
     const RawOptimum raw(RangeFiltered(k.scans[0], 0.0, kMapMaxRangeM));
     std::vector<core::VoxelMap> maps;
@@ -101,7 +102,7 @@ class RegistrationRealDataBalm : public ::testing::TestWithParam<FramePair> {};
 
 TEST_P(RegistrationRealDataBalm, PairLandsWithinTheTargetOfTheRawPointOptimum) {
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "balm";
-    if (!fs::exists(dir / "poses.txt")) GTEST_SKIP() << dir << " not found";
+    STRATA_SKIP_WITHOUT_DATA(dir / "poses.txt");
     const io::KittiSequence seq = io::OpenKittiSequence(dir);
     const FramePair pair = GetParam();
     const core::Scan a = io::ReadKittiScan(seq, pair.a), b = io::ReadKittiScan(seq, pair.b);
@@ -136,7 +137,7 @@ INSTANTIATE_TEST_SUITE_P(Pairs, RegistrationRealDataBalm, ::testing::ValuesIn(kB
 // 0.09 m / 0.18 deg apart; the known move is recovered on top of that.
 TEST(RegistrationRealData, BalmSecondSessionMovedByAKnownTransform) {
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "balm";
-    if (!fs::exists(dir / "poses.txt")) GTEST_SKIP() << dir << " not found";
+    STRATA_SKIP_WITHOUT_DATA(dir / "poses.txt");
     // Measured 0.088 m / 0.18 deg between the halves; the move recovered to 4 mm / 0.01 deg.
     constexpr double kPoseDisagreementM = 0.15, kPoseDisagreementDeg = 0.3;
     constexpr double kKnownMoveM = 0.01, kKnownMoveDeg = 0.03;

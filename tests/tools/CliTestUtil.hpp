@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
 #include <array>
 #include <chrono>
@@ -30,20 +32,48 @@ namespace strata::tools::test {
 namespace fs = std::filesystem;
 
 struct Result {
-    int code = 0;
+    int code = -1;    // exit code; -1 when the program did not exit by itself
+    int signal = 0;   // the signal that ended it (a crash), else 0
     std::string out;  // stdout and stderr together
 };
 
-/// Runs `strata ARGS` through the shell and waits for it.
+/// Runs `strata ARGS` through the shell (which execs it, so the status is the program's own) and
+/// waits for it. Nothing here signals the program: death by a signal is a crash and fails the
+/// calling test whatever it expected of the exit code.
 inline Result Strata(const std::string& args) {
-    const std::string cmd = std::string(STRATA_BINARY) + " " + args + " 2>&1";
+    const std::string cmd = "exec " + std::string(STRATA_BINARY) + " " + args + " 2>&1";
     Result r;
     FILE* pipe = ::popen(cmd.c_str(), "r");
     std::array<char, 4096> buf;
     while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
     const int status = pipe ? ::pclose(pipe) : -1;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
+    if (status != -1 && WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+    if (r.signal != 0) {
+        ADD_FAILURE() << "strata " << args << " died by signal " << r.signal << ":\n" << r.out;
+    }
     return r;
+}
+
+/// The exit codes of tools/strata/Main.cpp, one per kind of strata::Error (README, "Exit codes").
+enum ExitCode : int { kFailed = 1, kUsage = 2, kLocked = 3, kRefused = 4, kNotFound = 5,
+                      kBadFormat = 6 };
+
+/// A normal exit with exactly `code` whose output contains `message`: a crash, another code or a
+/// silent failure is not accepted. Use as EXPECT_TRUE(FailedWith(r, kNotFound, "no map")).
+inline ::testing::AssertionResult FailedWith(const Result& r, int code, const std::string& message) {
+    if (r.signal != 0) {
+        return ::testing::AssertionFailure() << "died by signal " << r.signal << ":\n" << r.out;
+    }
+    if (r.code != code) {
+        return ::testing::AssertionFailure() << "exit code " << r.code << ", expected " << code
+                                             << ":\n" << r.out;
+    }
+    if (r.out.find(message) == std::string::npos) {
+        return ::testing::AssertionFailure() << "output does not name \"" << message << "\":\n"
+                                             << r.out;
+    }
+    return ::testing::AssertionSuccess();
 }
 
 /// A `strata` process started with Spawn.

@@ -187,20 +187,20 @@ TEST(Diff, BadQueriesFailWithAMessageAndLeaveTheMapAlone) {
     const auto before = MapFiles(room.map);
     const std::string map = room.map.string();
     const struct {
-        std::string args, message;
+        std::string args;
+        int code;
+        std::string message;
     } cases[] = {
-        {map + " --from 1 --to 9", "no session"},
-        {map + " --from 1 --to nobody", "nobody"},
-        {map + " --from 1", "--to"},
-        {map + " --from 1 --to 2 --region 1,2,3", "region"},
-        {map + " --from 1 --to 2 --class spaceship", "spaceship"},
-        {map + " --from 1 --to 2 --png /nonexistent/dir/c.png", "/nonexistent/dir/c.png"},
-        {Temp("diff_nomap").string() + " --from 1 --to 2", "diff_nomap"},
+        {map + " --from 1 --to 9", kNotFound, "no session"},
+        {map + " --from 1 --to nobody", kNotFound, "nobody"},
+        {map + " --from 1", kUsage, "--to"},
+        {map + " --from 1 --to 2 --region 1,2,3", kUsage, "region"},
+        {map + " --from 1 --to 2 --class spaceship", kUsage, "spaceship"},
+        {map + " --from 1 --to 2 --png /nonexistent/dir/c.png", kFailed, "/nonexistent/dir/c.png"},
+        {Temp("diff_nomap").string() + " --from 1 --to 2", kNotFound, "diff_nomap"},
     };
     for (const auto& c : cases) {
-        const Result r = Strata("diff " + c.args);
-        EXPECT_NE(r.code, 0) << c.args;
-        EXPECT_NE(r.out.find(c.message), std::string::npos) << c.args << ": " << r.out;
+        EXPECT_TRUE(FailedWith(Strata("diff " + c.args), c.code, c.message)) << c.args;
     }
     EXPECT_EQ(MapFiles(room.map), before);
     EXPECT_EQ(Strata("diff " + map + " --list").code, 0);

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "RealData.hpp"
 #include "CliTestUtil.hpp"
 #include "RealPairs.hpp"
 #include "strata/store/MapStore.hpp"
@@ -111,7 +112,7 @@ TEST(RegistrationCli, RegistersAKitti00ScanOnTheRawPointOptimum) {
     using namespace registration::test;                 // NOLINT: the real-data references
     constexpr double kVsRawDeg = 0.03, kVsRawM = 0.005;  // measured 0.012 deg, 1.9 mm
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "kitti00";
-    if (!fs::exists(dir / "poses_sptam.txt")) GTEST_SKIP() << dir << " (stereo poses) not found";
+    STRATA_SKIP_WITHOUT_DATA(dir / "poses_sptam.txt");
     const Kitti00 k = LoadKitti00(dir);
     const RawOptimum::Result opt =
         RawOptimum(RangeFiltered(k.scans[0], 0.0, kMapMaxRangeM))

@@ -91,16 +91,11 @@ TEST(VehiclesCli, StoresTheCleanedMapAsOneCommitThatAsOfCanUndo) {
 TEST(VehiclesCli, BadArgumentsAndFailedOutputsLeaveTheMapAsItWas) {
     const fs::path map = CopyOfGarage("vehicles_bad");
     const auto before = MapFiles(map);
-    Result r = Strata("vehicles " + map.string() + " --source paint");
-    EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.out.find("paint"), std::string::npos) << r.out;
-    r = Strata("vehicles " + map.string() + " --png /nonexistent/dir/v.png");
-    EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.out.find("/nonexistent/dir/v.png"), std::string::npos) << r.out;
+    EXPECT_TRUE(FailedWith(Strata("vehicles " + map.string() + " --source paint"), kUsage, "paint"));
+    EXPECT_TRUE(FailedWith(Strata("vehicles " + map.string() + " --png /nonexistent/dir/v.png"),
+                           kFailed, "/nonexistent/dir/v.png"));
     EXPECT_EQ(MapFiles(map), before);
-    r = Strata("vehicles " + Temp("no_such_map").string());
-    EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.out.find("no map"), std::string::npos) << r.out;
+    EXPECT_TRUE(FailedWith(Strata("vehicles " + Temp("no_such_map").string()), kNotFound, "no map"));
 }
 
 }  // namespace

@@ -7,13 +7,26 @@
 #include <set>
 
 #include "strata/core/Error.hpp"
-#include "strata/walls/Clustering.hpp"
-#include "strata/walls/PlaneFit.hpp"
+#include "strata/geometry/Clustering.hpp"
+#include "strata/geometry/PlaneFit.hpp"
+#include "strata/walls/Slant.hpp"
 #include "strata/walls/WallReport.hpp"
 #include "strata/walls/Walls.hpp"
 
 namespace strata::walls {
 namespace {
+
+// The geometry module's clusters and plane fits are tested here, on the shapes walls meet.
+using geometry::Dbscan;
+using geometry::FitPlane;
+using geometry::KMeans;
+using geometry::kNoise;
+using geometry::Plane;
+using geometry::PlaneFit;
+using geometry::RansacPlane;
+using geometry::RansacResult;
+using geometry::RefinePlane;
+using geometry::XyEigenRatio;
 
 using openvdb::Coord;
 
@@ -97,8 +110,8 @@ TEST(KMeans, SeparatesThreeBlobsAndFollowsTheStudysRule) {
 }
 
 TEST(RansacPlane, KeepsThePlaneAndRejectsThirtyPercentOutliers) {
-    constexpr double kNoise = 0.01, kThreshold = 0.05, kAngleTolDeg = 0.3;
-    std::vector<Eigen::Vector3d> points = WallPoints(2.0, 8.0, 4.0, 700, kNoise, 1);
+    constexpr double kNoiseM = 0.01, kThreshold = 0.05, kAngleTolDeg = 0.3;
+    std::vector<Eigen::Vector3d> points = WallPoints(2.0, 8.0, 4.0, 700, kNoiseM, 1);
     const auto clutter = BushPoints(Eigen::Vector3d(4.0, 1.5, 2.0), 1.2, 300, 2);
     points.insert(points.end(), clutter.begin(), clutter.end());
     const RansacResult r = RansacPlane(points, kThreshold, 200, 3);

@@ -3,8 +3,10 @@
 // Skips when the data is absent.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 
+#include "RealData.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/walls/Walls.hpp"
@@ -28,39 +30,50 @@ core::VoxelMap Integrate(const fs::path& dir) {
     return map;
 }
 
-// Walls at least `min_length` long: found, near vertical against the ground, with an
-// uncertainty, and at least `min_walls` of them.
-void ExpectFacades(const WallResult& result, double min_length, size_t min_walls) {
+// What a map measured (2026-12-02, docs/walls.md): walls and facades counted exactly, the
+// frame's tilt within kTiltToleranceDeg.
+struct Expected {
+    double facade_min_length_m;
+    size_t walls, facades;
+    double tilt_deg;
+};
+constexpr double kTiltToleranceDeg = 0.1;
+
+// Every facade (a wall at least facade_min_length_m long) near vertical against the ground,
+// with an uncertainty; the counts and the tilt as measured.
+void ExpectFacades(const WallResult& result, const Expected& e) {
     size_t facades = 0;
     for (const Wall& w : result.walls) {
-        if (w.length_m < min_length) continue;
+        if (w.length_m < e.facade_min_length_m) continue;
         ++facades;
         EXPECT_GE(w.slant_deg, kMinPlausibleSlantDeg)
             << "wall " << w.id << " at " << w.centroid.transpose();
         EXPECT_GT(w.uncertainty_deg, 0.0);
         EXPECT_LT(w.uncertainty_deg, 0.5);
     }
-    EXPECT_GE(facades, min_walls);
+    std::printf("[ walls ] %zu walls, %zu facades, ground tilt %.2f deg\n", result.walls.size(),
+                facades, result.ground.tilt_deg);
+    EXPECT_EQ(result.walls.size(), e.walls);
+    EXPECT_EQ(facades, e.facades);
+    EXPECT_NEAR(result.ground.tilt_deg, e.tilt_deg, kTiltToleranceDeg);
     EXPECT_GE(result.ground.tilt_deg, kMinFrameTiltDeg);
     EXPECT_LE(result.ground.tilt_deg, kMaxFrameTiltDeg);
 }
 
 TEST(WallsRealData, BalmFacadesStandVertical) {
     const fs::path seq = fs::path(STRATA_DATA_DIR) / "balm";
-    if (!fs::exists(seq / "poses.txt")) GTEST_SKIP() << seq << " not found";
+    STRATA_SKIP_WITHOUT_DATA(seq / "poses.txt");
     WallConfig config;
     config.level_to_ground = true;
-    const WallResult result = FindWalls(Integrate(seq), config);
-    ExpectFacades(result, 10.0, 4);
+    ExpectFacades(FindWalls(Integrate(seq), config), {10.0, 16, 4, 2.73});
 }
 
 TEST(WallsRealData, Kitti00FacadesStandVertical) {
     const fs::path seq = fs::path(STRATA_DATA_DIR) / "kitti00";
-    if (!fs::exists(seq / "poses.txt")) GTEST_SKIP() << seq << " not found";
+    STRATA_SKIP_WITHOUT_DATA(seq / "poses.txt");
     WallConfig config;
     config.level_to_ground = true;
-    const WallResult result = FindWalls(Integrate(seq), config);
-    ExpectFacades(result, 5.0, 3);
+    ExpectFacades(FindWalls(Integrate(seq), config), {5.0, 20, 3, 1.55});
 }
 
 }  // namespace

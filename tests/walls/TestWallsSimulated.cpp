@@ -23,11 +23,20 @@ namespace fs = std::filesystem;
 
 // Voxel sizes the street is mapped at (the store's default and a finer one).
 const std::vector<double> kVoxelSizes = {0.2, 0.1};
-// The targets.
-constexpr double kMaxMeanSlantErrorDeg = 0.3;
-constexpr double kMaxSlantErrorDeg = 1.0;
-constexpr double kMinFoundFraction = 0.95;
-constexpr double kMaxVegetationAsWall = 0.05;
+// The targets are 0.3 deg mean and 1.0 deg max; these bounds are 2-3x what the default
+// pipeline measures (0.2 m: 0.049 / 0.093 deg, 0.1 m: 0.071 / 0.196 deg), so losing the robust
+// fit (least squares: 0.51 deg max at 0.2 m) fails them.
+struct SlantBounds {
+    double mean_deg, max_deg;
+};
+SlantBounds BoundsFor(double voxel) {
+    return voxel > 0.15 ? SlantBounds{0.12, 0.25} : SlantBounds{0.18, 0.5};
+}
+// street.json's walls longer than kMinTruthLengthM: every one must be found.
+constexpr size_t kTruthWalls = 10;
+// Vegetation parts the pipeline sees (measured 8 at 0.2 m, 14 at 0.1 m): at least this many, so
+// "no tree taken for a wall" is not vacuous.
+constexpr size_t kMinVegetationParts = 4;
 // Walls the targets count: longer than this.
 constexpr double kMinTruthLengthM = 3.0;
 // A detected wall's voxel is on a truth wall when this close to its plane and inside its front
@@ -187,12 +196,12 @@ TEST_P(WallsSimulated, StreetSlantsWithinTheTargets) {
         score.vegetation, result.walls.size(),
         result.stats.seconds_columns + result.stats.seconds_clustering +
             result.stats.seconds_fitting);
-    EXPECT_GE(static_cast<double>(score.found), kMinFoundFraction * score.counted);
-    EXPECT_LE(score.mean_error, kMaxMeanSlantErrorDeg);
-    EXPECT_LE(score.max_error, kMaxSlantErrorDeg);
-    EXPECT_GT(score.vegetation, 0u) << "the street has trees and bushes: the test must see them";
-    EXPECT_LE(static_cast<double>(score.vegetation_as_wall),
-              kMaxVegetationAsWall * score.vegetation);
+    EXPECT_EQ(score.counted, kTruthWalls) << "the ground truth's walls";
+    EXPECT_EQ(score.found, kTruthWalls);
+    EXPECT_LE(score.mean_error, BoundsFor(voxel).mean_deg);
+    EXPECT_LE(score.max_error, BoundsFor(voxel).max_deg);
+    EXPECT_GE(score.vegetation, kMinVegetationParts) << "the street's trees and bushes";
+    EXPECT_EQ(score.vegetation_as_wall, 0u);
 
     // What each refinement buys (printed for docs/walls.md; the targets are asserted above).
     struct Variant {

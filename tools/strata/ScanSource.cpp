@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "Progress.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/PoseFiles.hpp"
 
@@ -79,6 +80,23 @@ std::string ScanSource::Describe() const {
     return files_.empty() ? std::string() : files_.front().string();
 }
 
+namespace {
+
+// The same kind of error with `prefix` before its message: the exit code follows the kind.
+[[noreturn]] void RethrowPrefixed(const std::exception& e, const std::string& prefix) {
+    const std::string m = prefix + e.what();
+    if (dynamic_cast<const RefusedError*>(&e)) throw RefusedError(m);
+    if (dynamic_cast<const InvalidArgumentError*>(&e)) throw InvalidArgumentError(m);
+    if (dynamic_cast<const std::invalid_argument*>(&e)) throw InvalidArgumentError(m);
+    if (dynamic_cast<const FormatError*>(&e)) throw FormatError(m);
+    if (dynamic_cast<const NotFoundError*>(&e)) throw NotFoundError(m);
+    if (dynamic_cast<const MapLockedError*>(&e)) throw MapLockedError(m);
+    if (dynamic_cast<const IoError*>(&e)) throw IoError(m);
+    throw Error(m);
+}
+
+}  // namespace
+
 void IntegrateScans(store::SessionWriter& writer, const ScanSource& source) {
     Progress progress("integrating", source.size());
     for (size_t i = 0; i < source.size(); ++i) {
@@ -87,8 +105,7 @@ void IntegrateScans(store::SessionWriter& writer, const ScanSource& source) {
             (void)writer.Integrate(scan);
         } catch (const std::exception& e) {
             // Integration errors (a refused scan, a bad pose) get the scan they are about.
-            throw std::runtime_error("scan " + std::to_string(i) + " (" + scan.source +
-                                     "): " + e.what());
+            RethrowPrefixed(e, "scan " + std::to_string(i) + " (" + scan.source + "): ");
         }
         progress.Advance();
     }

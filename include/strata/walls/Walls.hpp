@@ -9,7 +9,7 @@
 
 #include "strata/columns/ColumnStats.hpp"
 #include "strata/core/VoxelMap.hpp"
-#include "strata/walls/PlaneFit.hpp"
+#include "strata/walls/Slant.hpp"
 
 namespace strata::walls {
 
@@ -64,6 +64,10 @@ struct WallConfig {
     /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;
 };
+
+/// @brief The study's rule for the number of K-means parts of a cluster: floor(n / divisor),
+/// at least 1.
+[[nodiscard]] int PartsFor(size_t n, int divisor);
 
 /// @brief One wall: a plane fitted to the voxels (their centres) of one or more parts.
 struct Wall {

@@ -1,12 +1,12 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
+#include <openvdb/Types.h>  // openvdb::Coord, without the grid types
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
-namespace strata::walls {
+namespace strata::geometry {
 
 /// Label of a point DBSCAN left unclustered.
 inline constexpr int kNoise = -1;
@@ -26,8 +26,4 @@ inline constexpr int kNoise = -1;
 [[nodiscard]] std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k,
                                       uint64_t seed = 1, int max_iterations = 15);
 
-/// @brief The study's rule for the number of K-means parts of a cluster: floor(n / divisor),
-/// at least 1.
-[[nodiscard]] int PartsFor(size_t n, int divisor);
-
-}  // namespace strata::walls
+}  // namespace strata::geometry

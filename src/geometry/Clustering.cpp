@@ -1,6 +1,8 @@
-#include "strata/walls/Clustering.hpp"
+#include "strata/geometry/Clustering.hpp"
 
 #include "strata/core/Error.hpp"
+
+#include <openvdb/openvdb.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +11,7 @@
 #include <utility>
 #include <stdexcept>
 
-namespace strata::walls {
+namespace strata::geometry {
 
 std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
                         int min_points) {
@@ -227,9 +229,4 @@ std::vector<int> KMeans(const std::vector<Eigen::Vector3d>& points, int k, uint6
     return assignment;
 }
 
-int PartsFor(size_t n, int divisor) {
-    if (divisor < 1) throw InvalidArgumentError("K-means divisor must be >= 1");
-    return std::max(1, static_cast<int>(n / static_cast<size_t>(divisor)));
-}
-
-}  // namespace strata::walls
+}  // namespace strata::geometry
