@@ -1,11 +1,18 @@
 // Integration benchmark: our Integrator against OctoMap's insertPointCloud on the same points,
-// in the same process (issue: the spine). Prints one markdown table row per (dataset, voxel size).
+// in the same process. Prints one docs/bench.md table row per (dataset, voxel size) and exits 1
+// when any voxel differs from OctoMap's (state, or log-odds by more than 1e-5).
 //
-//   bench_integration [DATA_DIR] [--scans N] [--voxel S ...] [--strata-only]
+//   bench_integration [DATA_DIR] [--scans N] [--voxel S ...] [--strata-only] [--counts] [--ci]
+//
+// --counts: also DDA steps and unique voxels per scan (for callgrind's instructions per step).
+// --ci: a short run (the first 10 BALM and 3 KITTI 00 scans at 0.2 m) that also exits 1 when a
+// row's speed-up falls below the documented short-run value / 2.5 or its memory ratio to OctoMap
+// rises above the documented one (memory is deterministic). CTest runs it (label `bench`).
 //
 // OctoMap is compiled here without OpenMP, so it runs on one thread, as it does by default.
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +20,7 @@
 #include <vector>
 
 #include "BenchSupport.hpp"
+#include "OctomapCompare.hpp"
 #include "VoxelSets.hpp"
 #include "strata/integration/Integrator.hpp"
 
@@ -22,6 +30,9 @@ namespace fs = std::filesystem;
 using strata::bench::Clock;
 using strata::bench::Seconds;
 
+constexpr double kMaxRange = 50.0;
+constexpr float kLogOddsTolerance = 1e-5f;
+
 struct WorldScan {
     std::vector<Eigen::Vector3f> points;  // world frame, float as OctoMap stores them
     Eigen::Vector3f origin;
@@ -30,8 +41,17 @@ struct WorldScan {
 struct Run {
     double ms_per_scan = 0.0;
     double mem_mb = 0.0;
-    strata::testing::VoxelSets sets;
+    double unique_voxels = 0.0;  // per scan: voxels of the scan's update
 };
+
+// Short-run floors (--ci), from docs/bench.md's "CI rows": speed-up / 2.5, memory ratio as is.
+struct CiFloor {
+    const char* dataset;
+    double min_speedup;
+    double max_memory_ratio;
+};
+// Measured 2026-12-02 on a loaded 2-vCPU VM: BALM 9.2x, 1.18; KITTI 00 11.1x, 1.14.
+constexpr CiFloor kCiFloors[] = {{"balm", 9.2 / 2.5, 1.19}, {"kitti00", 11.1 / 2.5, 1.15}};
 
 std::vector<WorldScan> LoadScans(const fs::path& dir, size_t max_scans, size_t& n_points) {
     std::vector<WorldScan> scans;
@@ -46,8 +66,24 @@ std::vector<WorldScan> LoadScans(const fs::path& dir, size_t max_scans, size_t& 
     return scans;
 }
 
-Run RunOctomap(const std::vector<WorldScan>& scans, double voxel, double max_range) {
-    octomap::OcTree tree(voxel);
+// DDA steps of a scan's rays, as the L1 distance in voxel keys from the sensor's voxel to each
+// (range-clipped) endpoint's: what a walk that steps one face at a time must take.
+double DdaSteps(const WorldScan& s, double voxel) {
+    const auto key = [voxel](const Eigen::Vector3d& p) {
+        return Eigen::Vector3d((p / voxel).array().floor());
+    };
+    const Eigen::Vector3d o = s.origin.cast<double>();
+    const Eigen::Vector3d k0 = key(o);
+    double steps = 0.0;
+    for (const auto& pf : s.points) {
+        Eigen::Vector3d d = pf.cast<double>() - o;
+        if (d.norm() > kMaxRange) d *= kMaxRange / d.norm();
+        steps += (key(o + d) - k0).cwiseAbs().sum();
+    }
+    return steps;
+}
+
+Run RunOctomap(const std::vector<WorldScan>& scans, octomap::OcTree& tree) {
     double seconds = 0.0;
     for (const auto& s : scans) {
         octomap::Pointcloud cloud;
@@ -55,20 +91,18 @@ Run RunOctomap(const std::vector<WorldScan>& scans, double voxel, double max_ran
         for (const auto& p : s.points) cloud.push_back(p.x(), p.y(), p.z());
         const auto start = Clock::now();
         tree.insertPointCloud(cloud, octomap::point3d(s.origin.x(), s.origin.y(), s.origin.z()),
-                              max_range);
+                              kMaxRange);
         seconds += Seconds(start);
     }
-    return {1e3 * seconds / scans.size(), tree.memoryUsage() / 1e6,
-            strata::testing::OctomapVoxelSets(tree)};
+    return {1e3 * seconds / scans.size(), tree.memoryUsage() / 1e6, 0.0};
 }
 
-Run RunStrata(const std::vector<WorldScan>& scans, double voxel, double max_range, int threads) {
+Run RunStrata(const std::vector<WorldScan>& scans, int threads, strata::core::VoxelMap& map) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    auto map = strata::core::VoxelMap::Create(voxel);
     strata::integration::IntegrationConfig config;
-    config.max_range_m = max_range;
+    config.max_range_m = kMaxRange;
     strata::integration::Integrator integrator(map, config);
-    double seconds = 0.0;
+    double seconds = 0.0, unique = 0.0;
     for (const auto& s : scans) {
         strata::core::Scan scan;
         scan.T_world_sensor = Eigen::Translation3d(s.origin.cast<double>()) *
@@ -80,12 +114,14 @@ Run RunStrata(const std::vector<WorldScan>& scans, double voxel, double max_rang
             scan.points.push_back(p.cast<double>() - s.origin.cast<double>());
         }
         const auto start = Clock::now();
-        (void)integrator.Integrate(scan);
+        const auto update = integrator.Integrate(scan);
         seconds += Seconds(start);
+        unique += static_cast<double>(update.free->activeVoxelCount() +
+                                      update.occupied->activeVoxelCount());
     }
     double mem = 0.0;
     for (const auto& g : map.Grids()) mem += static_cast<double>(g->memUsage());
-    return {1e3 * seconds / scans.size(), mem / 1e6, strata::testing::StrataVoxelSets(map)};
+    return {1e3 * seconds / scans.size(), mem / 1e6, unique / scans.size()};
 }
 
 }  // namespace
@@ -94,25 +130,30 @@ int main(int argc, char** argv) {
     fs::path data = STRATA_DATA_DIR;
     size_t max_scans = 1000;
     std::vector<double> voxels;
-    bool with_octomap = true;  // --strata-only: for profiling our side alone
+    bool with_octomap = true;  // --strata-only: one thread, no OctoMap (for callgrind)
+    bool counts = false, ci = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--scans" && i + 1 < argc) {
             max_scans = std::stoul(argv[++i]);
         } else if (a == "--strata-only") {
             with_octomap = false;
+        } else if (a == "--counts") {
+            counts = true;
+        } else if (a == "--ci") {
+            ci = true;
         } else if (a == "--voxel" && i + 1 < argc) {
             voxels.push_back(std::stod(argv[++i]));
         } else {
             data = a;
         }
     }
-    if (voxels.empty()) voxels = {0.2, 0.1};
-    const double max_range = 50.0;
+    if (voxels.empty()) voxels = ci ? std::vector<double>{0.2} : std::vector<double>{0.2, 0.1};
     std::printf("| dataset | voxel m | scans | pts/scan | OctoMap ms/scan | strata 1T ms/scan | "
                 "speed-up 1T | strata 2T ms/scan | 2T vs 1T | strata 1T Mpts/s | OctoMap MB | "
-                "strata MB | Jaccard occ | Jaccard free |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                "strata MB | Jaccard occ | Jaccard free | voxels differing |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    int failures = 0;
     for (const char* name : {"balm", "kitti00"}) {
         const fs::path dir = data / name;
         if (!fs::exists(dir / "velodyne")) {
@@ -120,22 +161,66 @@ int main(int argc, char** argv) {
             continue;
         }
         size_t n_points = 0;
-        const auto scans = LoadScans(dir, max_scans, n_points);
+        const size_t n = ci ? (std::string(name) == "balm" ? 10 : 3) : max_scans;
+        const auto scans = LoadScans(dir, n, n_points);
         for (const double voxel : voxels) {
-            const Run octo = with_octomap ? RunOctomap(scans, voxel, max_range) : Run{};
-            const Run one = RunStrata(scans, voxel, max_range, 1);
-            const Run two = RunStrata(scans, voxel, max_range, 2);
+            octomap::OcTree tree(voxel);
+            const Run octo = with_octomap ? RunOctomap(scans, tree) : Run{};
+            auto map = strata::core::VoxelMap::Create(voxel);
+            const Run one = RunStrata(scans, 1, map);
+            auto map2 = strata::core::VoxelMap::Create(voxel);
+            const Run two = with_octomap ? RunStrata(scans, 2, map2) : one;
             const double pts_per_scan = static_cast<double>(n_points) / scans.size();
+            const double speedup = octo.ms_per_scan / one.ms_per_scan;
+            double jaccard_occ = 0.0, jaccard_free = 0.0;
+            size_t differing = 0;
+            if (with_octomap) {
+                const auto ours = strata::testing::StrataVoxelSets(map);
+                const auto theirs = strata::testing::OctomapVoxelSets(tree);
+                jaccard_occ = strata::testing::Jaccard(ours.occupied, theirs.occupied);
+                jaccard_free = strata::testing::Jaccard(ours.free, theirs.free);
+                differing = strata::testing::CompareWithOctomap(map, tree, kLogOddsTolerance).total();
+            }
             std::printf("| %s | %.2f | %zu | %.0f | %.1f | %.1f | %.1fx | %.1f | %.2fx | %.2f | %.1f "
-                        "| %.1f | %.4f | %.4f |\n",
+                        "| %.1f | %.4f | %.4f | %zu |\n",
                         name, voxel, scans.size(), pts_per_scan, octo.ms_per_scan, one.ms_per_scan,
-                        octo.ms_per_scan / one.ms_per_scan, two.ms_per_scan,
-                        one.ms_per_scan / two.ms_per_scan, pts_per_scan / one.ms_per_scan / 1e3,
-                        octo.mem_mb, one.mem_mb,
-                        strata::testing::Jaccard(one.sets.occupied, octo.sets.occupied),
-                        strata::testing::Jaccard(one.sets.free, octo.sets.free));
+                        speedup, two.ms_per_scan, one.ms_per_scan / two.ms_per_scan,
+                        pts_per_scan / one.ms_per_scan / 1e3, octo.mem_mb, one.mem_mb,
+                        jaccard_occ, jaccard_free, differing);
+            if (counts) {
+                double steps = 0.0;
+                for (const auto& s : scans) steps += DdaSteps(s, voxel);
+                steps /= scans.size();
+                std::printf("  counts: %.0f DDA steps/scan, %.0f unique voxels/scan, %.1f steps per "
+                            "unique voxel\n",
+                            steps, one.unique_voxels, steps / one.unique_voxels);
+                for (const auto& g : map.Grids()) {
+                    std::printf("  grid %s: %.2f MB, %zu leaves, %zu active voxels\n",
+                                g->getName().c_str(), static_cast<double>(g->memUsage()) / 1e6,
+                                static_cast<size_t>(g->baseTreePtr()->leafCount()),
+                                static_cast<size_t>(g->activeVoxelCount()));
+                }
+            }
             std::fflush(stdout);
+            if (differing > 0) {
+                std::fprintf(stderr, "FAIL %s %.2f: %zu voxels differ from OctoMap\n", name, voxel,
+                             differing);
+                ++failures;
+            }
+            for (const CiFloor& f : kCiFloors) {
+                if (!ci || std::string(f.dataset) != name) continue;
+                if (speedup < f.min_speedup) {
+                    std::fprintf(stderr, "FAIL %s: speed-up %.1fx below the floor %.1fx\n", name,
+                                 speedup, f.min_speedup);
+                    ++failures;
+                }
+                if (one.mem_mb > f.max_memory_ratio * octo.mem_mb) {
+                    std::fprintf(stderr, "FAIL %s: memory %.1f MB above %.2f x OctoMap's %.1f MB\n",
+                                 name, one.mem_mb, f.max_memory_ratio, octo.mem_mb);
+                    ++failures;
+                }
+            }
         }
     }
-    return EXIT_SUCCESS;
+    return failures == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
 }

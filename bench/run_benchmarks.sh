@@ -17,12 +17,17 @@ cpu=$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)
   echo
   echo "Same float points, same process, max range 50 m. OctoMap: \`OcTree::insertPointCloud\`"
   echo "(compiled without OpenMP, i.e. one thread). strata: \`Integrator::Integrate\` with TBB limited"
-  echo "to 1 and 2 threads. Memory: \`OcTree::memoryUsage()\` vs the sum of \`memUsage()\` of our five"
-  echo "grids (occupancy, label, label_weight, hits, point_mean). Jaccard: occupied and free voxel sets, OctoMap's"
-  echo "pruned nodes expanded to voxels. Targets (issue 2) and where the time goes:"
-  echo "[integration.md, Speed](integration.md#speed)."
+  echo "to 1 and 2 threads. Memory: \`OcTree::memoryUsage()\` vs the sum of \`memUsage()\` of the map's"
+  echo "grids (occupancy, label, label_weight, endpoints). Jaccard: occupied and free voxel sets, OctoMap's"
+  echo "pruned nodes expanded to voxels; \"voxels differing\": every voxel of both maps compared, state and"
+  echo "log-odds (1e-5), and the program exits 1 if any differs. Targets (issues 2 and 19) and where the"
+  echo "time and bytes go: [integration.md, Speed and Memory](integration.md#speed)."
   echo
   "$build/bench/bench_integration" "$root/../shared/data"
+  echo
+  echo "Short run (\`bench_integration --ci\`, CTest \`BenchIntegrationCi\`, label \`bench\`):"
+  echo
+  "$build/bench/bench_integration" "$root/../shared/data" --ci
   if [[ -x "$build/bench/bench_store" ]]; then
     echo
     echo "## Store"

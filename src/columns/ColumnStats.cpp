@@ -84,7 +84,7 @@ ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map) {
     }
     ColumnGrid g = Allocate(box);
     if (g.empty()) return g;
-    auto hits = map.hits ? std::optional(map.hits->getConstAccessor()) : std::nullopt;
+    auto hits = map.endpoints ? std::optional(core::EndpointReader(map)) : std::nullopt;
     auto label = map.label ? std::optional(map.label->getConstAccessor()) : std::nullopt;
     for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
         if (*it <= 0.0f) continue;
@@ -92,7 +92,7 @@ ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map) {
         it.getBoundingBox(voxels);  // one voxel, or every voxel of a tile
         for (auto v = voxels.begin(); v; ++v) {
             const openvdb::Coord& ijk = *v;
-            const int64_t points = hits ? hits->getValue(ijk) : 1;
+            const int64_t points = hits ? hits->Hits(ijk) : 1;
             const int cls = label ? label->getValue(ijk) : -1;
             AddVoxel(g.Mutable(ijk.x(), ijk.y()), ijk.z(), points, cls);
         }

@@ -1,8 +1,11 @@
 #include "strata/core/VoxelMap.hpp"
 
+#include <openvdb/tree/LeafManager.h>
+
 #include <algorithm>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::core {
@@ -27,18 +30,62 @@ typename GridT::Ptr FindGrid(const openvdb::GridPtrVec& grids, const char* name)
         if (g && g->getName() == name) {
             auto typed = openvdb::gridPtrCast<GridT>(g);
             if (!typed) {
-                throw std::runtime_error(std::string("grid '") + name + "' has type " + g->type() +
+                throw FormatError(std::string("grid '") + name + "' has type " + g->type() +
                                          ", expected " + GridT::gridType());
             }
             return typed;
         }
     }
-    throw std::runtime_error(std::string("the map has no '") + name + "' grid");
+    throw FormatError(std::string("the map has no '") + name + "' grid");
 }
 
 bool HasGrid(const openvdb::GridPtrVec& grids, const char* name) {
     return std::any_of(grids.begin(), grids.end(),
                        [&](const auto& g) { return g && g->getName() == name; });
+}
+
+void Stamp(openvdb::GridBase& grid, const Eigen::Vector3d& origin) {
+    grid.insertMeta("producer", openvdb::StringMetadata(kProducer));
+    grid.insertMeta("origin", openvdb::Vec3DMetadata(openvdb::Vec3d(origin.x(), origin.y(),
+                                                                    origin.z())));
+}
+
+openvdb::Int32Grid::Ptr MakeEndpointGrid(const openvdb::math::Transform::Ptr& xform) {
+    auto grid = MakeGrid<openvdb::Int32Grid>(grid_names::kEndpoints, xform, "packed",
+                                             openvdb::GRID_UNKNOWN);
+    grid->insertMeta("encoding",
+                     openvdb::StringMetadata(
+                         "bits 0-10: hit count (saturating at 2047); bits 11-17, 18-24, 25-31: "
+                         "mean endpoint offset from the voxel centre along x, y, z, in steps of "
+                         "voxel/127, 63 = centre; strata export --format vdb writes them expanded "
+                         "as 'hits' and 'point_mean'"));
+    return grid;
+}
+
+// `hits` (and `point_mean`, when the map has it) of a map written before `endpoints` existed,
+// packed; a voxel without a mean gets its centre.
+template <typename RequireAligned>
+openvdb::Int32Grid::Ptr PackOldEndpoints(const openvdb::GridPtrVec& grids, double voxel_size,
+                                         const RequireAligned& require_aligned) {
+    const auto hits = FindGrid<openvdb::Int32Grid>(grids, grid_names::kHits);
+    require_aligned(*hits);
+    openvdb::Vec3SGrid::Ptr means;
+    if (HasGrid(grids, grid_names::kPointMean)) {
+        means = FindGrid<openvdb::Vec3SGrid>(grids, grid_names::kPointMean);
+        require_aligned(*means);
+    }
+    auto packed = MakeEndpointGrid(hits->transform().copy());
+    auto out = packed->getAccessor();
+    for (auto it = hits->cbeginValueOn(); it; ++it) {
+        openvdb::CoordBBox box;
+        it.getBoundingBox(box);
+        for (const openvdb::Coord& ijk : box) {
+            openvdb::Vec3s m(0.0f);
+            if (means) means->tree().probeValue(ijk, m);
+            out.setValueOn(ijk, endpoint::Pack(*it, Eigen::Vector3d(m[0], m[1], m[2]), voxel_size));
+        }
+    }
+    return packed;
 }
 
 }  // namespace
@@ -52,10 +99,10 @@ openvdb::math::Transform::Ptr VoxelMap::MakeTransform(double voxel_size_m) {
 
 VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
     if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m)) {
-        throw std::invalid_argument("voxel size must be positive, got " +
+        throw InvalidArgumentError("voxel size must be positive, got " +
                                     std::to_string(voxel_size_m));
     }
-    if (!origin.allFinite()) throw std::invalid_argument("map origin must be finite");
+    if (!origin.allFinite()) throw InvalidArgumentError("map origin must be finite");
     openvdb::initialize();
     VoxelMap map;
     map.voxel_size = voxel_size_m;
@@ -67,10 +114,7 @@ VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
                                              openvdb::GRID_UNKNOWN);
     map.label_weight = MakeGrid<openvdb::FloatGrid>(grid_names::kLabelWeight, xform, "votes",
                                                     openvdb::GRID_UNKNOWN);
-    map.hits = MakeGrid<openvdb::Int32Grid>(grid_names::kHits, xform, "points",
-                                            openvdb::GRID_UNKNOWN);
-    map.point_mean = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean, xform,
-                                                  "m from the voxel centre", openvdb::GRID_UNKNOWN);
+    map.endpoints = MakeEndpointGrid(xform);
     map.label->insertMeta("class_legend", openvdb::StringMetadata(LegendJson()));
     return map;
 }
@@ -80,17 +124,40 @@ VoxelMap VoxelMap::DeepCopy() const {
     copy.occupancy = occupancy ? occupancy->deepCopy() : nullptr;
     copy.label = label ? label->deepCopy() : nullptr;
     copy.label_weight = label_weight ? label_weight->deepCopy() : nullptr;
-    copy.hits = hits ? hits->deepCopy() : nullptr;
-    copy.point_mean = point_mean ? point_mean->deepCopy() : nullptr;
+    copy.endpoints = endpoints ? endpoints->deepCopy() : nullptr;
     return copy;
 }
 
 openvdb::GridPtrVec VoxelMap::Grids() const {
-    openvdb::GridPtrVec grids{occupancy, label, label_weight, hits, point_mean};
-    for (auto& g : grids) {
-        g->insertMeta("producer", openvdb::StringMetadata(kProducer));
-        g->insertMeta("origin", openvdb::Vec3DMetadata(openvdb::Vec3d(origin.x(), origin.y(),
-                                                                      origin.z())));
+    openvdb::GridPtrVec grids{occupancy, label, label_weight, endpoints};
+    for (auto& g : grids) Stamp(*g, origin);
+    return grids;
+}
+
+openvdb::GridPtrVec VoxelMap::ExportGrids() const {
+    openvdb::GridPtrVec grids = Grids();
+    grids.pop_back();  // endpoints, expanded instead
+    auto hits = MakeGrid<openvdb::Int32Grid>(grid_names::kHits, occupancy->transform().copy(),
+                                             "points", openvdb::GRID_UNKNOWN);
+    auto means = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean,
+                                              occupancy->transform().copy(),
+                                              "m from the voxel centre", openvdb::GRID_UNKNOWN);
+    hits->tree().topologyUnion(endpoints->tree());
+    means->tree().topologyUnion(endpoints->tree());
+    openvdb::tree::LeafManager<openvdb::Int32Tree> leaves(hits->tree());
+    leaves.foreach([&](openvdb::Int32Tree::LeafNodeType& leaf, size_t) {
+        const auto* packed = endpoints->tree().probeConstLeaf(leaf.origin());
+        auto* mean = means->tree().probeLeaf(leaf.origin());
+        for (auto on = leaf.beginValueOn(); on; ++on) {
+            const int32_t value = packed->getValue(on.pos());
+            on.setValue(endpoint::Hits(value));
+            const Eigen::Vector3f offset = endpoint::Offset(value, voxel_size).cast<float>();
+            mean->setValueOnly(on.pos(), openvdb::Vec3s(offset.x(), offset.y(), offset.z()));
+        }
+    });
+    for (const auto& g : {openvdb::GridBase::Ptr(hits), openvdb::GridBase::Ptr(means)}) {
+        Stamp(*g, origin);
+        grids.push_back(g);
     }
     return grids;
 }
@@ -100,32 +167,39 @@ VoxelMap VoxelMap::FromGrids(const openvdb::GridPtrVec& grids) {
     map.occupancy = FindGrid<openvdb::FloatGrid>(grids, grid_names::kOccupancy);
     map.label = FindGrid<openvdb::Int32Grid>(grids, grid_names::kLabel);
     map.label_weight = FindGrid<openvdb::FloatGrid>(grids, grid_names::kLabelWeight);
-    map.hits = FindGrid<openvdb::Int32Grid>(grids, grid_names::kHits);
-    if (HasGrid(grids, grid_names::kPointMean)) {
-        map.point_mean = FindGrid<openvdb::Vec3SGrid>(grids, grid_names::kPointMean);
-    } else {  // written before the grid existed
-        map.point_mean = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean,
-                                                      map.occupancy->transform().copy(),
-                                                      "m from the voxel centre",
-                                                      openvdb::GRID_UNKNOWN);
-    }
     const openvdb::Vec3d vs = map.occupancy->voxelSize();
     if (!(vs[0] > 0.0) || vs[0] != vs[1] || vs[0] != vs[2]) {
-        throw std::runtime_error("the occupancy grid does not have cubic voxels");
+        throw FormatError("the occupancy grid does not have cubic voxels");
     }
     map.voxel_size = vs[0];
     const auto expected = MakeTransform(map.voxel_size);
-    for (const auto& g : {openvdb::GridBase::Ptr(map.label), openvdb::GridBase::Ptr(map.label_weight),
-                          openvdb::GridBase::Ptr(map.hits), openvdb::GridBase::Ptr(map.point_mean)}) {
-        if (g->transform() != *expected) {
-            throw std::runtime_error("grid '" + g->getName() + "' is not aligned with 'occupancy'");
+    const auto require_aligned = [&](const openvdb::GridBase& g) {
+        if (g.transform() != *expected) {
+            throw FormatError("grid '" + g.getName() + "' is not aligned with 'occupancy'");
         }
+    };
+    for (const auto& g : {openvdb::GridBase::Ptr(map.label), openvdb::GridBase::Ptr(map.label_weight)}) {
+        require_aligned(*g);
+    }
+    if (HasGrid(grids, grid_names::kEndpoints)) {
+        map.endpoints = FindGrid<openvdb::Int32Grid>(grids, grid_names::kEndpoints);
+        require_aligned(*map.endpoints);
+    } else {  // written before endpoints were packed: `hits`, and `point_mean` if at all
+        map.endpoints = PackOldEndpoints(grids, map.voxel_size, require_aligned);
     }
     if (const auto meta = map.occupancy->getMetadata<openvdb::Vec3DMetadata>("origin")) {
         const openvdb::Vec3d o = meta->value();
         map.origin = Eigen::Vector3d(o[0], o[1], o[2]);
     }
     return map;
+}
+
+bool VoxelMap::IsMapGrid(const std::string& name) {
+    for (const char* own : {grid_names::kOccupancy, grid_names::kLabel, grid_names::kLabelWeight,
+                            grid_names::kEndpoints, grid_names::kHits, grid_names::kPointMean}) {
+        if (name == own) return true;
+    }
+    return false;
 }
 
 openvdb::Coord VoxelMap::WorldToVoxel(const Eigen::Vector3d& p_map) const {
@@ -140,13 +214,20 @@ Eigen::Vector3d VoxelMap::VoxelCenter(const openvdb::Coord& ijk) const {
            voxel_size;
 }
 
+int32_t VoxelMap::Hits(const openvdb::Coord& ijk) const {
+    return endpoint::Hits(endpoints->tree().getValue(ijk));
+}
+
 Eigen::Vector3d VoxelMap::PointMean(const openvdb::Coord& ijk) const {
-    Eigen::Vector3d p = VoxelCenter(ijk);
-    openvdb::Vec3s offset;
-    if (point_mean && point_mean->tree().probeValue(ijk, offset)) {
-        p += Eigen::Vector3d(offset[0], offset[1], offset[2]);
-    }
-    return p;
+    int32_t packed = 0;
+    return endpoints->tree().probeValue(ijk, packed)
+               ? VoxelCenter(ijk) + endpoint::Offset(packed, voxel_size)
+               : VoxelCenter(ijk);
+}
+
+void VoxelMap::SetEndpoints(const openvdb::Coord& ijk, int64_t hits,
+                            const Eigen::Vector3d& offset_m) {
+    endpoints->tree().setValueOn(ijk, endpoint::Pack(hits, offset_m, voxel_size));
 }
 
 }  // namespace strata::core

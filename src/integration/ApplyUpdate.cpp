@@ -35,33 +35,22 @@ void ApplyOccupancy(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
 }
 
 void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const IntegrationConfig& config) {
-    // Hits: activate every endpoint voxel (parallel topologyUnion), then add counts straight into
-    // the leaf buffers; groups come sorted, so consecutive groups mostly share a leaf.
-    openvdb::Int32Tree& hits = map.hits->tree();
-    hits.topologyUnion(*update.occupied);
-    // The mean endpoint position follows the counts, m' = (m n + sum) / (n + k), in the leaf
-    // with the same origin in `point_mean`, activated the same way.
-    openvdb::Vec3STree* means = config.keep_point_means ? &map.point_mean->tree() : nullptr;
-    if (means) means->topologyUnion(*update.occupied);
-    const double half = 0.5 * map.voxel_size;
+    // Hits and mean endpoint, packed in one value: activate every endpoint voxel (parallel
+    // topologyUnion), then update the values straight in the leaf buffers; groups come sorted, so
+    // consecutive groups mostly share a leaf. The mean is a running mean over all scans
+    // (core/Endpoints.hpp, Accumulate).
+    openvdb::Int32Tree& endpoints = map.endpoints->tree();
+    endpoints.topologyUnion(*update.occupied);
+    const double s = map.voxel_size;
     openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
-    openvdb::Vec3STree::LeafNodeType* mean_leaf = nullptr;
     for (const EndpointGroup& g : update.endpoints) {
         const openvdb::Coord origin(g.ijk.x() & ~7, g.ijk.y() & ~7, g.ijk.z() & ~7);
-        if (!leaf || origin != leaf->origin()) {
-            leaf = hits.probeLeaf(g.ijk);
-            if (means) mean_leaf = means->probeLeaf(g.ijk);
-        }
-        const openvdb::Index offset = leaf->coordToOffset(g.ijk);
-        int32_t& count = leaf->buffer().data()[offset];
-        const double before = count;
-        count += g.points;
-        if (!means) continue;
-        openvdb::Vec3s& mean = mean_leaf->buffer().data()[offset];
-        for (int a = 0; a < 3; ++a) {
-            const double v = (mean[a] * before + g.offset_sum[a]) / count;
-            mean[a] = static_cast<float>(std::clamp(v, -half, half));
-        }
+        if (!leaf || origin != leaf->origin()) leaf = endpoints.probeLeaf(g.ijk);
+        int32_t& packed = leaf->buffer().data()[leaf->coordToOffset(g.ijk)];
+        packed = config.keep_point_means
+                     ? core::endpoint::Accumulate(packed, g.points, g.offset_sum, s, g.ijk)
+                     : core::endpoint::Pack(core::endpoint::Hits(packed) + int64_t{g.points},
+                                            Eigen::Vector3d::Zero(), s);
     }
 
     auto label = map.label->getAccessor();

@@ -54,8 +54,8 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
 }
 
 // Refuses an update whose new leaves would grow the map's grids by more than the budget: every
-// new leaf of the observed voxels costs an occupancy leaf, every new endpoint leaf also a hits,
-// point-mean, label and label-weight leaf.
+// new leaf of the observed voxels costs an occupancy leaf, every new endpoint leaf also an
+// endpoints, label and label-weight leaf.
 void RequireUpdateFits(const ScanUpdate& update, const core::VoxelMap& map,
                        const IntegrationConfig& config) {
     const auto& occupancy = map.occupancy->tree();
@@ -68,10 +68,13 @@ void RequireUpdateFits(const ScanUpdate& update, const core::VoxelMap& map,
         new_observed += fresh && !update.free->probeConstLeaf(leaf->origin());
         new_endpoint += fresh;
     }
-    constexpr size_t kObservedLeaf = sizeof(openvdb::FloatTree::LeafNodeType);
-    constexpr size_t kEndpointLeaf = sizeof(openvdb::Int32Tree::LeafNodeType) * 2 +
-                                     sizeof(openvdb::FloatTree::LeafNodeType) +
-                                     sizeof(openvdb::Vec3STree::LeafNodeType);
+    // A leaf's values live in a buffer of their own, beside the node.
+    constexpr auto leaf_bytes = [](auto value) {
+        using Leaf = typename openvdb::tree::Tree4<decltype(value), 5, 4, 3>::Type::LeafNodeType;
+        return sizeof(Leaf) + Leaf::SIZE * sizeof(decltype(value));
+    };
+    constexpr size_t kObservedLeaf = leaf_bytes(0.0f);
+    constexpr size_t kEndpointLeaf = 2 * leaf_bytes(int32_t{0}) + leaf_bytes(0.0f);
     const double bytes = static_cast<double>(new_observed) * kObservedLeaf +
                          static_cast<double>(new_endpoint) * kEndpointLeaf;
     if (bytes > static_cast<double>(config.max_update_bytes)) {

@@ -40,38 +40,53 @@ struct Bitmap {
     }
 };
 
-// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel and every voxel up to, not
-// including, the end voxel. Terminating on the crossing count replaces OctoMap's key comparison.
-// The box check bounds every write, whatever the rounding does.
+// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel, then every voxel the walk enters
+// until it enters the end voxel or a voxel it would leave beyond the ray's length (OctoMap's
+// guard against rounding near the end: such a voxel is not marked). The exit distance of the
+// current voxel is the smallest tMax, which is the one the walk steps on, so the guard costs one
+// comparison per step. The box check bounds every write, whatever the rounding does; the box's
+// padding of one voxel holds every voxel the walk can enter, so it never cuts a ray short.
 template <typename MarkFn>
 inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark) {
-    if (ray.steps == 0) return;  // origin and end share a voxel: no free cells
+    if (ray.start == ray.end) return;  // origin and end share a voxel: no free cells
     // Locals, not members: the marks are stores the compiler cannot prove apart from `ray`, so
     // values read through `ray` would be reloaded after every store.
     int64_t pos = ray.start;
+    const int64_t end = ray.end;
     const int64_t s0 = ray.stride[0], s1 = ray.stride[1], s2 = ray.stride[2];
     const double d0 = ray.t_delta[0], d1 = ray.t_delta[1], d2 = ray.t_delta[2];
+    const double length = ray.length;
     double t0 = ray.t_max[0], t1 = ray.t_max[1], t2 = ray.t_max[2];
-    mark(pos);
-    for (int32_t s = 1, n = ray.steps; s < n; ++s) {
+    mark(pos);  // OctoMap adds the origin's key before any test
+    for (;;) {
         // Same tie-breaking as OctoMap: x before z, y before z, y before x only when strictly less.
+        // The exit distance of voxel `pos` is the tMax the walk steps on: beyond the length, the
+        // voxel is not marked and the walk ends. (For the origin voxel, marked above, ending here
+        // gives OctoMap's set too: exit distances never decrease along the walk.)
         if (t0 < t1) {
             if (t0 < t2) {
+                if (t0 > length) return;
+                mark(pos);
                 t0 += d0;
                 pos += s0;
             } else {
+                if (t2 > length) return;
+                mark(pos);
                 t2 += d2;
                 pos += s2;
             }
         } else if (t1 < t2) {
+            if (t1 > length) return;
+            mark(pos);
             t1 += d1;
             pos += s1;
         } else {
+            if (t2 > length) return;
+            mark(pos);
             t2 += d2;
             pos += s2;
         }
-        if (static_cast<uint64_t>(pos) >= box_size) return;
-        mark(pos);
+        if (pos == end || static_cast<uint64_t>(pos) >= box_size) return;
     }
 }
 

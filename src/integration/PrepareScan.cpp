@@ -1,5 +1,5 @@
 // Step 1 of integrating a scan: filter points, find the voxel box, and set up one DDA per ray with
-// OctoMap's arithmetic (OcTreeBaseImpl::computeRayKeys), so that maps agree voxel by voxel.
+// OctoMap's arithmetic (RayArithmetic.hpp), so that maps agree voxel by voxel.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "RayArithmetic.hpp"
 #include "RayMarking.hpp"
 
 namespace strata::integration::detail {
@@ -17,22 +18,21 @@ constexpr int64_t kMaxBoxExtent = int64_t{1} << 20;  // voxels per axis
 constexpr int64_t kMaxBoxVoxels = int64_t{1} << 55;  // leaves 8 bits for the class in sort keys
 constexpr size_t kPointGrain = 4096;
 
-// floor() for |v| < 2^31 without a libm call (x86-64 baseline has no SSE4.1 roundsd).
-int32_t FloorToInt(double v) {
-    const auto i = static_cast<int32_t>(v);
-    return i - static_cast<int32_t>(v < i);
-}
-
-// OctoMap's coordToKey: floor(coordinate / resolution). Callers keep |p / s| below 1e9.
-openvdb::Coord Key(const Eigen::Vector3d& p, double inv_voxel) {
-    return {FloorToInt(p.x() * inv_voxel), FloorToInt(p.y() * inv_voxel),
-            FloorToInt(p.z() * inv_voxel)};
-}
-
 // Keys must stay far from int32 overflow when the box is padded and aligned.
 bool KeyInRange(const Eigen::Vector3d& p, double inv_voxel) {
     constexpr double kLimit = 1e9;
     return (p * inv_voxel).cwiseAbs().maxCoeff() < kLimit;
+}
+
+// OctoMap's float arithmetic where OctoMap could hold every voxel of the scan: its keys span
+// 2^16 voxels centred on the map origin, and rays reach at most max range from the sensor.
+// Beyond (or for endpoint-only clouds, whose reach is unbounded) double precision.
+bool UseFloatRays(const Eigen::Vector3d& origin_map, double inv_voxel,
+                  const IntegrationConfig& config) {
+    if (!config.octomap_arithmetic || config.points_only) return false;
+    constexpr double kOctomapKeys = 32768.0;  // tree_max_val: keys [-2^15, 2^15) around 0
+    const double reach = std::ceil(config.max_range_m * inv_voxel) + 2.0;
+    return ((origin_map * inv_voxel).cwiseAbs().array() + reach < kOctomapKeys - 1.0).all();
 }
 
 VoxelBox MakeBox(openvdb::CoordBBox bbox) {
@@ -55,31 +55,8 @@ VoxelBox MakeBox(openvdb::CoordBBox bbox) {
 }  // namespace
 
 RaySetup SetupRay(const PreparedScan& scan, size_t i) {
-    RaySetup ray;
-    if (scan.points_only || scan.kinds[i] == PointKind::kDropped) return ray;  // no steps
-    const Eigen::Vector3d& end = scan.ends[i];
-    const double s = scan.voxel_size;
-    const openvdb::Coord key_end = Key(end, scan.inv_voxel_size);
-    const openvdb::Coord& key_origin = scan.key_origin;
-    ray.start = scan.box.Index(key_origin);
-    const int64_t strides[3] = {scan.box.ny * scan.box.nz, scan.box.nz, 1};
-    Eigen::Vector3d direction = end - scan.origin;
-    direction *= 1.0 / direction.norm();
-    for (int a = 0; a < 3; ++a) {
-        const int delta = key_end[a] - key_origin[a];
-        ray.steps += std::abs(delta);
-        if (delta == 0) {
-            // The ray never leaves this slab: never pick this axis.
-            ray.t_max[a] = std::numeric_limits<double>::infinity();
-            continue;
-        }
-        const int step = delta > 0 ? 1 : -1;
-        ray.stride[a] = step * strides[a];
-        const double border = (key_origin[a] + 0.5) * s + step * s * 0.5;
-        ray.t_max[a] = (border - scan.origin[a]) / direction[a];
-        ray.t_delta[a] = s / std::fabs(direction[a]);
-    }
-    return ray;
+    if (scan.points_only || scan.kinds[i] == PointKind::kDropped) return {};  // no free cells
+    return scan.float_rays ? SetupRayIn<float>(scan, i) : SetupRayIn<double>(scan, i);
 }
 
 PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
@@ -90,8 +67,9 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
         throw std::invalid_argument("the sensor origin is not finite or too far from the map origin");
     }
     PreparedScan scan;
-    scan.origin = origin_map;
-    scan.key_origin = Key(origin_map, inv_voxel);
+    scan.float_rays = UseFloatRays(origin_map, inv_voxel, config);
+    scan.origin = scan.float_rays ? origin_map.cast<float>().cast<double>() : origin_map;
+    scan.key_origin = Key(scan.origin, inv_voxel);
     scan.voxel_size = voxel_size;
     scan.inv_voxel_size = inv_voxel;
     scan.points_only = config.points_only;
@@ -100,6 +78,13 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
     scan.kinds.resize(n);
 
     // Pass 1 (parallel): classify each point, clip long rays, grow the box over the ray ends.
+    const auto classify = [&](auto zero, size_t i) {
+        using T = decltype(zero);
+        Vec3<T> end = Vec3<T>::Zero();
+        scan.kinds[i] = ClassifyPoint<T>(points_map[i].cast<T>(), scan.origin.cast<T>(),
+                                         inv_voxel, config, end);
+        scan.ends[i] = end.template cast<double>();
+    };
     using Range = tbb::blocked_range<size_t>;
     const openvdb::CoordBBox bbox = tbb::parallel_reduce(
         // Range
@@ -109,21 +94,8 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
         // 1st reduction: one chunk of points
         [&](const Range& r, openvdb::CoordBBox box) {
             for (size_t i = r.begin(); i != r.end(); ++i) {
-                const Eigen::Vector3d& p = points_map[i];
-                PointKind& kind = scan.kinds[i];
-                const double range = (p - origin_map).norm();
-                if (!p.allFinite() || !KeyInRange(p, inv_voxel) || range < config.min_range_m) {
-                    kind = PointKind::kDropped;
-                    continue;
-                }
-                if (config.points_only || range <= config.max_range_m) {
-                    kind = PointKind::kHit;
-                    scan.ends[i] = p;
-                } else {
-                    kind = PointKind::kClipped;
-                    scan.ends[i] = origin_map + (p - origin_map) * (config.max_range_m / range);
-                }
-                box.expand(Key(scan.ends[i], inv_voxel));
+                scan.float_rays ? classify(0.0f, i) : classify(0.0, i);
+                if (scan.kinds[i] != PointKind::kDropped) box.expand(Key(scan.ends[i], inv_voxel));
             }
             return box;
         },

@@ -41,14 +41,15 @@ private:
     }
 };
 
-/// One ray in voxel terms, ready for the DDA: the start index, per-axis step strides, and the
-/// parametric distances of OctoMap's computeRayKeys (tMax, tDelta, in metres).
+/// One ray in voxel terms, ready for the DDA: the start and end indices, per-axis step strides,
+/// and OctoMap's computeRayKeys quantities (tMax, tDelta, length, in metres).
 struct RaySetup {
     int64_t start = 0;
+    int64_t end = 0;  // == start: origin and end share a voxel, no free cells
     int64_t stride[3] = {0, 0, 0};
     double t_max[3] = {0, 0, 0};
     double t_delta[3] = {0, 0, 0};
-    int32_t steps = 0;  // voxel boundaries crossed from the origin voxel to the end voxel
+    double length = 0.0;  // OctoMap's float ray length: the walk stops past it
 };
 
 /// What each point of a scan contributes.
@@ -57,6 +58,8 @@ enum class PointKind : uint8_t { kDropped, kHit, kClipped };
 /// Endpoints and rays of one scan after filtering, in the map frame.
 struct PreparedScan {
     VoxelBox box;
+    /// Rays in OctoMap's float arithmetic (origin and ends are then float values); else double.
+    bool float_rays = true;
     Eigen::Vector3d origin;             // sensor origin, map frame
     openvdb::Coord key_origin;
     double voxel_size = 0.0;
@@ -71,6 +74,7 @@ struct PreparedScan {
 };
 
 /// Filters points, computes the box and the endpoint voxels (parallel over points).
+/// With float rays, points and origin are rounded to float first (OctoMap's point3d).
 [[nodiscard]] PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                                        const Eigen::Vector3d& origin_map, double voxel_size,
                                        const IntegrationConfig& config);

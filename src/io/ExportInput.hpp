@@ -17,7 +17,8 @@ namespace strata::io::detail {
 /// @brief Throws InvalidArgumentError unless the map has all grids and a voxel size.
 /// @param target what is being exported, for the message ("'out/map.ply'").
 inline void RequireGrids(const core::VoxelMap& map, const std::string& target) {
-    if (!map.occupancy || !map.label || !map.label_weight || !map.hits || !(map.voxel_size > 0.0)) {
+    if (!map.occupancy || !map.label || !map.label_weight || !map.endpoints ||
+        !(map.voxel_size > 0.0)) {
         throw InvalidArgumentError("cannot export " + target +
                                     ": the map is not initialised (use VoxelMap::Create)");
     }

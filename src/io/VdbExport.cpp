@@ -96,7 +96,9 @@ void WriteVdb(const core::VoxelMap& map, const std::filesystem::path& path,
               const VdbExportOptions& options) {
     detail::RequireGrids(map, path);
     openvdb::initialize();
-    openvdb::GridPtrVec grids = map.Grids();  // also stamps producer and origin on each grid
+    // Endpoints expanded into `hits` and `point_mean`, which other tools read without a codec;
+    // also stamps producer and origin on each grid.
+    openvdb::GridPtrVec grids = map.ExportGrids();
     if (options.include_density) grids.push_back(MakeDensityGrid(map));
     if (options.include_color) grids.push_back(MakeColorGrid(map));
 

@@ -125,18 +125,14 @@ std::vector<Eigen::Vector3d> CollectPoints(const core::VoxelMap& map, const Tree
     const double s = map.voxel_size;
     leaves.foreach ([&](const typename TreeT::LeafNodeType& leaf, size_t li) {
         std::vector<Eigen::Vector3d>& out = per_leaf[li];
-        auto means = map.point_mean->getConstAccessor();
+        core::EndpointReader means(map);
         for (auto it = leaf.cbeginValueOn(); it; ++it) {
             if (!keep(*it)) continue;
             const openvdb::Coord ijk = it.getCoord();
             const Eigen::Vector3d center((ijk.x() + 0.5) * s, (ijk.y() + 0.5) * s,
                                          (ijk.z() + 0.5) * s);
             if (bounds && !bounds->contains(center)) continue;
-            Eigen::Vector3d p = center;
-            openvdb::Vec3s offset;
-            if (means.probeValue(ijk, offset))
-                p += Eigen::Vector3d(offset[0], offset[1], offset[2]);
-            out.push_back(p);
+            out.push_back(means.PointMean(ijk));
         }
     });
     std::vector<Eigen::Vector3d> points;
@@ -161,13 +157,13 @@ Surface Surface::FromPoints(const std::vector<Eigen::Vector3d>& points,
 
 std::vector<Eigen::Vector3d> OccupiedPoints(const core::VoxelMap& map,
                                             const std::optional<Eigen::AlignedBox3d>& bounds) {
-    if (!map.occupancy || !map.point_mean) return {};
+    if (!map.occupancy || !map.endpoints) return {};
     return CollectPoints(map, map.occupancy->tree(), bounds, [](float v) { return v > 0.0f; });
 }
 
 std::vector<Eigen::Vector3d> MaskedPoints(const core::VoxelMap& map, const openvdb::BoolGrid& mask,
                                           const std::optional<Eigen::AlignedBox3d>& bounds) {
-    if (!map.point_mean) return {};
+    if (!map.endpoints) return {};
     return CollectPoints(map, mask.tree(), bounds, [](bool) { return true; });
 }
 

@@ -39,20 +39,17 @@ struct Eraser {
         : occupancy(map.occupancy->getAccessor()),
           label(map.label->getAccessor()),
           weight(map.label_weight->getAccessor()),
-          hits(map.hits->getAccessor()),
-          mean(map.point_mean->getAccessor()) {}
+          endpoints(map.endpoints->getAccessor()) {}
     void Erase(const openvdb::Coord& c) {
         occupancy.setValueOff(c, 0.0F);
         label.setValueOff(c, 0);
         weight.setValueOff(c, 0.0F);
-        hits.setValueOff(c, 0);
-        mean.setValueOff(c, openvdb::Vec3s(0.0F));
+        endpoints.setValueOff(c, 0);
     }
     openvdb::FloatGrid::Accessor occupancy;
     openvdb::Int32Grid::Accessor label;
     openvdb::FloatGrid::Accessor weight;
-    openvdb::Int32Grid::Accessor hits;
-    openvdb::Vec3SGrid::Accessor mean;
+    openvdb::Int32Grid::Accessor endpoints;
 };
 
 // z = a + b dx + c dy around `centre`, by least squares with Huber weights (IRLS): a few ring
@@ -230,7 +227,7 @@ void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& grou
     auto occ = map.occupancy->getAccessor();
     auto label = map.label->getAccessor();
     auto weight = map.label_weight->getAccessor();
-    auto mean = map.point_mean->getAccessor();
+    auto endpoints = map.endpoints->getAccessor();
     auto mark = refilled.getAccessor();
     for (const Cell& c : cells) {
         // Without a ray check, a cell seen empty is trusted to be a gap.
@@ -242,7 +239,10 @@ void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& grou
         label.setValue(c.ijk, static_cast<int32_t>(core::SemanticClass::kGround));
         weight.setValue(c.ijk, 1.0F);
         const double offset = c.z - map.VoxelCenter(c.ijk).z();
-        mean.setValue(c.ijk, openvdb::Vec3s(0.0F, 0.0F, static_cast<float>(offset)));
+        // The refilled height as the voxel's point mean; its hit count (no points) is kept.
+        const int32_t hits = core::endpoint::Hits(endpoints.getValue(c.ijk));
+        endpoints.setValue(c.ijk, core::endpoint::Pack(hits, Eigen::Vector3d(0.0, 0.0, offset),
+                                                       map.voxel_size));
         mark.setValue(c.ijk, static_cast<float>(c.z));
         ++vehicle.refilled_cells;
     }

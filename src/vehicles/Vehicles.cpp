@@ -17,7 +17,7 @@ namespace {
 constexpr double kRadToDeg = 57.29577951308232;
 
 void Validate(const core::VoxelMap& map, const VehicleConfig& c) {
-    if (!map.occupancy || !map.label || !map.label_weight || !map.hits || !map.point_mean ||
+    if (!map.occupancy || !map.label || !map.label_weight || !map.endpoints ||
         !(map.voxel_size > 0.0)) {
         throw InvalidArgumentError("vehicles: the map is not initialised (use VoxelMap::Create)");
     }

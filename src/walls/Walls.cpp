@@ -336,13 +336,13 @@ public:
         Plane plane =
             RansacPlane(points, threshold_, config_.ransac_iterations, config_.seed + group[0])
                 .plane;
-        auto hits = map_.hits->getConstAccessor();
+        core::EndpointReader hits(map_);
         std::vector<Eigen::Vector3d> near;
         std::vector<double> weights;
         for (size_t n = 0; n < voxels.size(); ++n) {
             if (std::abs(plane.Distance(points[n])) > threshold_) continue;
             near.push_back(points[n]);
-            weights.push_back(std::max(1, hits.getValue(voxels[n])));
+            weights.push_back(std::max(1, hits.Hits(voxels[n])));
         }
         if (near.size() < 3) return std::nullopt;
         plane = config_.refine ? RefinePlane(near, plane, 0.25 * threshold_, weights)

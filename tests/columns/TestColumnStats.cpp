@@ -17,17 +17,16 @@ using openvdb::Coord;
 core::VoxelMap HandMadeMap() {
     core::VoxelMap map = core::VoxelMap::Create(0.5);
     auto occ = map.occupancy->getAccessor();
-    auto hits = map.hits->getAccessor();
     auto label = map.label->getAccessor();
     // Column (0, 0): a wall of 4 voxels, k = 1..4, 3 points each, building.
     for (int k = 1; k <= 4; ++k) {
         occ.setValueOn(Coord(0, 0, k), 0.85f);
-        hits.setValueOn(Coord(0, 0, k), 3);
+        map.SetEndpoints(Coord(0, 0, k), 3, Eigen::Vector3d::Zero());
         label.setValueOn(Coord(0, 0, k), static_cast<int>(core::SemanticClass::kBuilding));
     }
     // Column (2, -1): one ground voxel at k = 0 with 7 points, and a free voxel above it.
     occ.setValueOn(Coord(2, -1, 0), 1.5f);
-    hits.setValueOn(Coord(2, -1, 0), 7);
+    map.SetEndpoints(Coord(2, -1, 0), 7, Eigen::Vector3d::Zero());
     label.setValueOn(Coord(2, -1, 0), static_cast<int>(core::SemanticClass::kGround));
     occ.setValueOn(Coord(2, -1, 1), -0.4f);  // observed free: not counted
     return map;

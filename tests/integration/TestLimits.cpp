@@ -67,7 +67,7 @@ TEST(Limits, EmptyAndAllNanScansChangeNothing) {
     EXPECT_EQ(dropped.points, 1000u);
     EXPECT_EQ(dropped.dropped, 1000u);
     EXPECT_EQ(map.occupancy->activeVoxelCount(), 0u);
-    EXPECT_EQ(map.hits->activeVoxelCount(), 0u);
+    EXPECT_EQ(map.endpoints->activeVoxelCount(), 0u);
     // A sensor pose that is not finite is refused, naming the problem.
     core::Scan bad = SphereScan(10, 5.0, 1);
     bad.T_world_sensor.translation().x() = std::numeric_limits<double>::infinity();
@@ -80,9 +80,11 @@ TEST(Limits, EmptyAndAllNanScansChangeNothing) {
 }
 
 TEST(Limits, CoordinatesAMillionMetresOutWorkWithOrWithoutAnOrigin) {
-    // 1e6 m is 1e7 voxels of 0.1 m: inside the index range, and the integrator's double math
-    // keeps the same voxels as near the origin. With the map origin there, exports keep
-    // centimetres in float32 too (TestIntegrator checks that case).
+    // 1e6 m is 1e7 voxels of 0.1 m: inside the index range but beyond OctoMap's (2^15 voxels),
+    // so rays there run in double precision and keep the same voxels as double-precision rays
+    // near the origin (where the default is OctoMap's float arithmetic, turned off here to
+    // compare like with like). With the map origin there, exports keep centimetres in float32
+    // too (TestIntegrator checks that case).
     const Eigen::Vector3d far(1e6, -1e6, 250.0);
     core::Scan near = SphereScan(20000, 20.0, 2);
     near.T_world_sensor.translation() = Eigen::Vector3d(0.03, 0.07, 0.01);
@@ -90,7 +92,9 @@ TEST(Limits, CoordinatesAMillionMetresOutWorkWithOrWithoutAnOrigin) {
     shifted.T_world_sensor.pretranslate(far);
     core::VoxelMap a = core::VoxelMap::Create(0.1);
     core::VoxelMap b = core::VoxelMap::Create(0.1);
-    const ScanUpdate ua = ComputeScanUpdate(near, a, {});
+    IntegrationConfig double_rays;
+    double_rays.octomap_arithmetic = false;
+    const ScanUpdate ua = ComputeScanUpdate(near, a, double_rays);
     const ScanUpdate ub = ComputeScanUpdate(shifted, b, {});
     EXPECT_EQ(ua.occupied->activeVoxelCount(), ub.occupied->activeVoxelCount());
     EXPECT_EQ(ua.free->activeVoxelCount(), ub.free->activeVoxelCount());

@@ -37,7 +37,7 @@ inline void Put(core::VoxelMap& map, const openvdb::Coord& ijk, float log_odds, 
     if (log_odds > 0.0f) {
         map.label->tree().setValueOn(ijk, static_cast<int32_t>(c));
         map.label_weight->tree().setValueOn(ijk, 1.5f);
-        map.hits->tree().setValueOn(ijk, 3);
+        map.SetEndpoints(ijk, 3, Eigen::Vector3d(0.01, -0.02, 0.0));
     }
 }
 

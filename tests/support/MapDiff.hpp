@@ -36,7 +36,7 @@ std::string FirstDifference(const char* name, const GridT& actual, const GridT& 
 }
 
 /// "" when two maps are equal voxel by voxel (voxel size, origin, occupancy, label, label weight,
-/// hits), else the first difference.
+/// endpoints: hits and point means), else the first difference.
 inline std::string MapDifference(const core::VoxelMap& actual, const core::VoxelMap& expected) {
     if (actual.voxel_size != expected.voxel_size || actual.origin != expected.origin) {
         return "voxel size or origin differ";
@@ -45,7 +45,7 @@ inline std::string MapDifference(const core::VoxelMap& actual, const core::Voxel
          {FirstDifference("occupancy", *actual.occupancy, *expected.occupancy),
           FirstDifference("label", *actual.label, *expected.label),
           FirstDifference("label_weight", *actual.label_weight, *expected.label_weight),
-          FirstDifference("hits", *actual.hits, *expected.hits)}) {
+          FirstDifference("endpoints", *actual.endpoints, *expected.endpoints)}) {
         if (!diff.empty()) return diff;
     }
     return {};

@@ -166,14 +166,11 @@ TEST(Slant, KnownTiltsAndLeanDirections) {
 core::VoxelMap HandMadeStreet(double voxel) {
     core::VoxelMap map = core::VoxelMap::Create(voxel);
     auto occ = map.occupancy->getAccessor();
-    auto hits = map.hits->getAccessor();
-    auto mean = map.point_mean->getAccessor();
     const auto put = [&](const Eigen::Vector3d& p) {
         const Coord c = map.WorldToVoxel(p);
         const Eigen::Vector3d offset = p - map.VoxelCenter(c);
         occ.setValueOn(c, 1.0f);
-        hits.setValueOn(c, 1);
-        mean.setValueOn(c, openvdb::Vec3s(offset.x(), offset.y(), offset.z()));
+        map.SetEndpoints(c, 1, offset);
     };
     for (double x = -5.0; x < 20.0; x += voxel) {
         for (double y = -8.0; y < 6.0; y += voxel) put({x + 0.3 * voxel, y + 0.3 * voxel, 0.01});
@@ -228,8 +225,6 @@ TEST(FindWalls, EstimatesTheGroundTiltAndCanMeasureAgainstIt) {
     core::VoxelMap rolled = core::VoxelMap::Create(0.2);
     const Eigen::Matrix3d roll = Eigen::AngleAxisd(1.5 * kRad, Eigen::Vector3d::UnitX()).matrix();
     auto occ = rolled.occupancy->getAccessor();
-    auto hits = rolled.hits->getAccessor();
-    auto mean = rolled.point_mean->getAccessor();
     for (auto it = level.occupancy->cbeginValueOn(); it; ++it) {
         const Eigen::Vector3d p = roll * level.PointMean(it.getCoord());
         const Coord c = rolled.WorldToVoxel(p);
@@ -239,8 +234,7 @@ TEST(FindWalls, EstimatesTheGroundTiltAndCanMeasureAgainstIt) {
         }
         const Eigen::Vector3d offset = p - rolled.VoxelCenter(c);
         occ.setValueOn(c, 1.0f);
-        hits.setValueOn(c, 1);
-        mean.setValueOn(c, openvdb::Vec3s(offset.x(), offset.y(), offset.z()));
+        rolled.SetEndpoints(c, 1, offset);
     }
     const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(rolled);
     EXPECT_NEAR(EstimateGround(rolled, cols).tilt_deg, 1.5, kTiltTolDeg);

@@ -21,6 +21,10 @@ struct IntegrationConfig {
     /// one thread: about +35 %; two threads: +4 %). Off: the grid stays empty and analyses fall
     /// back to voxel centres.
     bool keep_point_means = true;
+    /// Rays in OctoMap 1.9.7's float arithmetic, so maps equal OctoMap's voxel for voxel and value
+    /// for value, wherever OctoMap could hold the scan (within 2^15 voxels of the map origin);
+    /// beyond that, for `points_only`, and when false: the same algorithm in double precision.
+    bool octomap_arithmetic = true;
     /// Largest growth of the map's grids one scan may cause (its new VDB leaves times their size).
     /// A scan needing more is refused with std::runtime_error before the map changes: fine voxels
     /// over long rays allocate a 2-8 kB leaf for every 8^3 block a ray crosses (1 cm voxels and

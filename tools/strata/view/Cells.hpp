@@ -38,7 +38,7 @@ struct TileGrids {
     openvdb::Int32Grid::ConstPtr cleared;   ///< vehicle id of each removed voxel
     openvdb::FloatGrid::ConstPtr refilled;  ///< refilled ground voxels
     // For a voxel's record only:
-    openvdb::Int32Grid::ConstPtr hits;
+    openvdb::Int32Grid::ConstPtr endpoints;  ///< hits and point mean, packed (core/Endpoints.hpp)
     std::vector<std::pair<int64_t, openvdb::BoolGrid::ConstPtr>> sessions_free;
 };
 

@@ -20,7 +20,7 @@ size_t Bytes(const GridPtr& grid) {
 
 size_t Bytes(const TileGrids& g) {
     size_t bytes = Bytes(g.occupancy) + Bytes(g.label) + Bytes(g.slant_deg) + Bytes(g.wall_id) +
-                   Bytes(g.cleared) + Bytes(g.refilled) + Bytes(g.hits);
+                   Bytes(g.cleared) + Bytes(g.refilled) + Bytes(g.endpoints);
     for (const auto& layers : {&g.sessions, &g.sessions_free}) {
         for (const auto& [id, layer] : *layers) bytes += Bytes(layer);
     }

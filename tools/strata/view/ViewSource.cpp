@@ -294,7 +294,7 @@ TileGrids ViewSource::ReadTile(const TileRef& ref) const {
     TileGrids grids;
     grids.occupancy = fused->occupancy;
     grids.label = fused->label;
-    grids.hits = fused->hits;
+    grids.endpoints = fused->endpoints;
     for (const int64_t session : impl_->snapshots[it->second].sessions) {
         if (const auto layer = reader.Layers(key, session)) {
             grids.sessions.emplace_back(session, layer->occupied);

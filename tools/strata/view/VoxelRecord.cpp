@@ -52,7 +52,9 @@ json ViewService::Impl::VoxelRecord(int64_t commit, const openvdb::Coord& ijk) {
             static_cast<core::SemanticClass>(grids->label->getConstAccessor().getValue(ijk));
         out["class"] = core::ClassName(c);
     }
-    if (grids->hits) out["hits"] = grids->hits->getConstAccessor().getValue(ijk);
+    if (grids->endpoints) {
+        out["hits"] = core::endpoint::Hits(grids->endpoints->getConstAccessor().getValue(ijk));
+    }
     for (const auto& [key, layers] : {std::pair{"seen_occupied_by", &grids->sessions},
                                       std::pair{"seen_free_by", &grids->sessions_free}}) {
         json ids = json::array();
