@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "strata/columns/ColumnStats.hpp"
+#include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 
@@ -27,7 +28,7 @@ py::dict QueryOccupancy(const core::VoxelMap& map, const py::array& points) {
         py::gil_scoped_release release;
         const auto occupancy = map.occupancy->getConstAccessor();
         const auto labels = map.label->getConstAccessor();
-        const auto counts = map.hits->getConstAccessor();
+        core::EndpointReader counts(map);
         for (size_t i = 0; i < p.size(); ++i) {
             if (!p[i].allFinite()) continue;
             const openvdb::Coord ijk = map.WorldToVoxel(p[i]);
@@ -36,7 +37,7 @@ py::dict QueryOccupancy(const core::VoxelMap& map, const py::array& points) {
             state[i] = value > 0.0f ? 1 : 0;
             log_odds[i] = value;
             label[i] = labels.getValue(ijk);
-            hits[i] = counts.getValue(ijk);
+            hits[i] = counts.Hits(ijk);
         }
     }
     py::dict out;
@@ -69,7 +70,7 @@ py::dict QueryBox(const core::VoxelMap& map, const py::object& lo, const py::obj
                                      openvdb::Coord(last(max.x()), last(max.y()), last(max.z())));
         const auto labels = map.label->getConstAccessor();
         const auto weights = map.label_weight->getConstAccessor();
-        const auto counts = map.hits->getConstAccessor();
+        core::EndpointReader counts(map);
         // Active voxels only, never the dense box (STYLE.md E); a tile is expanded to voxels.
         for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
             openvdb::CoordBBox part = it.getBoundingBox();
@@ -87,7 +88,7 @@ py::dict QueryBox(const core::VoxelMap& map, const py::object& lo, const py::obj
                 log_odds.push_back(value);
                 label.push_back(labels.getValue(v));
                 weight.push_back(weights.getValue(v));
-                hits.push_back(counts.getValue(v));
+                hits.push_back(counts.Hits(v));
             }
         }
     }
