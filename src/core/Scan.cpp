@@ -1,5 +1,7 @@
 #include "strata/core/Scan.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <stdexcept>
 
 namespace strata::core {
@@ -8,19 +10,19 @@ void Scan::Validate() const {
     const std::string where = source.empty() ? std::string("scan") : source;
     const size_t n = points.size();
     if (!labels.empty() && labels.size() != n) {
-        throw std::invalid_argument(where + ": " + std::to_string(labels.size()) + " labels for " +
+        throw InvalidArgumentError(where + ": " + std::to_string(labels.size()) + " labels for " +
                                     std::to_string(n) + " points");
     }
     if (!instances.empty() && instances.size() != n) {
-        throw std::invalid_argument(where + ": " + std::to_string(instances.size()) +
+        throw InvalidArgumentError(where + ": " + std::to_string(instances.size()) +
                                     " instance ids for " + std::to_string(n) + " points");
     }
     if (!intensity.empty() && intensity.size() != n) {
-        throw std::invalid_argument(where + ": " + std::to_string(intensity.size()) +
+        throw InvalidArgumentError(where + ": " + std::to_string(intensity.size()) +
                                     " intensities for " + std::to_string(n) + " points");
     }
     if (!T_world_sensor.matrix().allFinite()) {
-        throw std::invalid_argument(where + ": the sensor pose is not finite");
+        throw InvalidArgumentError(where + ": the sensor pose is not finite");
     }
 }
 

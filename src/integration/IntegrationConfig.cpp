@@ -1,5 +1,7 @@
 #include "strata/integration/IntegrationConfig.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -8,7 +10,7 @@ namespace strata::integration {
 namespace {
 
 void Require(bool ok, const std::string& what) {
-    if (!ok) throw std::invalid_argument("integration config: " + what);
+    if (!ok) throw InvalidArgumentError("integration config: " + what);
 }
 
 bool IsProbability(double p) { return p > 0.0 && p < 1.0; }

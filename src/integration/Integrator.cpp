@@ -1,5 +1,7 @@
 #include "strata/integration/Integrator.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -85,7 +87,7 @@ void RequireUpdateFits(const ScanUpdate& update, const core::VoxelMap& map,
                       "or a shorter max range",
                       bytes / 1e9, new_observed, map.voxel_size,
                       static_cast<double>(config.max_update_bytes) / 1e9);
-        throw std::runtime_error(text);
+        throw RefusedError(text);
     }
 }
 
@@ -95,7 +97,7 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                              const IntegrationConfig& config) {
     config.Validate();
     scan.Validate();
-    if (!(map.voxel_size > 0.0)) throw std::invalid_argument("the map has no voxel size");
+    if (!(map.voxel_size > 0.0)) throw InvalidArgumentError("the map has no voxel size");
 
     // Map frame = world frame shifted by the map's georeferenced origin.
     std::vector<Eigen::Vector3d> points_map(scan.points.size());

@@ -9,6 +9,8 @@
 #include <stdexcept>
 
 #include "RayArithmetic.hpp"
+
+#include "strata/core/Error.hpp"
 #include "RayMarking.hpp"
 
 namespace strata::integration::detail {
@@ -46,7 +48,7 @@ VoxelBox MakeBox(openvdb::CoordBBox bbox) {
     box.nz = int64_t{hi.z()} - box.lo.z();
     if (box.nx > kMaxBoxExtent || box.ny > kMaxBoxExtent || box.nz > kMaxBoxExtent ||
         box.size() >= kMaxBoxVoxels) {
-        throw std::invalid_argument("a scan spans more than 2^20 voxels along one axis; use a "
+        throw InvalidArgumentError("a scan spans more than 2^20 voxels along one axis; use a "
                                     "larger voxel size or a smaller max range");
     }
     return box;
@@ -64,7 +66,7 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                          const IntegrationConfig& config) {
     const double inv_voxel = 1.0 / voxel_size;
     if (!origin_map.allFinite() || !KeyInRange(origin_map, inv_voxel)) {
-        throw std::invalid_argument("the sensor origin is not finite or too far from the map origin");
+        throw InvalidArgumentError("the sensor origin is not finite or too far from the map origin");
     }
     PreparedScan scan;
     scan.float_rays = UseFloatRays(origin_map, inv_voxel, config);

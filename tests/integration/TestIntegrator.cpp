@@ -1,5 +1,7 @@
 #include "strata/integration/Integrator.hpp"
 
+#include "strata/core/Error.hpp"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -243,10 +245,10 @@ TEST(Integrator, RejectsBadConfigAndMismatchedLabels) {
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     IntegrationConfig bad;
     bad.max_range_m = -1.0;
-    EXPECT_THROW(Integrator(map, bad), std::invalid_argument);
+    EXPECT_THROW(Integrator(map, bad), InvalidArgumentError);
     core::Scan scan = RoomScan(1, 10);
     scan.labels.resize(3);
-    EXPECT_THROW((void)ComputeScanUpdate(scan, map, IntegrationConfig{}), std::invalid_argument);
+    EXPECT_THROW((void)ComputeScanUpdate(scan, map, IntegrationConfig{}), InvalidArgumentError);
 }
 
 }  // namespace

@@ -16,6 +16,8 @@
 
 #include "strata/integration/Integrator.hpp"
 
+#include "strata/core/Error.hpp"
+
 namespace strata::integration {
 namespace {
 
@@ -74,7 +76,7 @@ TEST(Limits, EmptyAndAllNanScansChangeNothing) {
     try {
         (void)integrator.Integrate(bad);
         ADD_FAILURE() << "an infinite pose was accepted";
-    } catch (const std::invalid_argument& e) {
+    } catch (const InvalidArgumentError& e) {
         EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
     }
 }
@@ -105,7 +107,7 @@ TEST(Limits, CoordinatesAMillionMetresOutWorkWithOrWithoutAnOrigin) {
     // Beyond the index range (1e9 voxels) a sensor is refused, and far points are dropped.
     core::Scan beyond = near;
     beyond.T_world_sensor.translation() = Eigen::Vector3d(2e8, 0.0, 0.0);
-    EXPECT_THROW((void)ComputeScanUpdate(beyond, a, {}), std::invalid_argument);
+    EXPECT_THROW((void)ComputeScanUpdate(beyond, a, {}), InvalidArgumentError);
     core::Scan stray = near;
     stray.points.push_back(Eigen::Vector3d(5e8, 0.0, 0.0));
     EXPECT_EQ(ComputeScanUpdate(stray, a, {}).dropped, 1u);
@@ -130,7 +132,7 @@ TEST(Limits, CentimetreVoxelsOverALargeAreaAreRefusedBeforeMemoryRunsOut) {
     try {
         (void)integrator.Integrate(SphereScan(20000, 40.0, 3));
         ADD_FAILURE() << "a 20 GB update was accepted";
-    } catch (const std::runtime_error& e) {
+    } catch (const RefusedError& e) {
         EXPECT_NE(std::string(e.what()).find("larger voxel size"), std::string::npos) << e.what();
         std::printf("refused: %s\n", e.what());
     }

@@ -21,7 +21,7 @@ struct Scan {
     std::string source;  ///< file the scan came from, for error messages and the catalog
 
     [[nodiscard]] bool has_labels() const { return !labels.empty(); }
-    /// @brief Throws std::invalid_argument (naming `source`) when per-point arrays disagree in size
+    /// @brief Throws InvalidArgumentError (naming `source`) when per-point arrays disagree in size
     /// or the pose is not finite.
     void Validate() const;
 };

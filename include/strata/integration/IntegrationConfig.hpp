@@ -26,7 +26,7 @@ struct IntegrationConfig {
     /// beyond that, for `points_only`, and when false: the same algorithm in double precision.
     bool octomap_arithmetic = true;
     /// Largest growth of the map's grids one scan may cause (its new VDB leaves times their size).
-    /// A scan needing more is refused with std::runtime_error before the map changes: fine voxels
+    /// A scan needing more is refused with RefusedError before the map changes: fine voxels
     /// over long rays allocate a 2-8 kB leaf for every 8^3 block a ray crosses (1 cm voxels and
     /// 20k rays of 40 m: ~20 GB), which would otherwise exhaust memory.
     size_t max_update_bytes = size_t{2} << 30;
@@ -34,7 +34,7 @@ struct IntegrationConfig {
     /// box needs more are marked sparsely (slower, bounded memory).
     size_t dense_scratch_limit_bytes = size_t{64} << 20;
 
-    /// @brief Throws std::invalid_argument naming the first bad field.
+    /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;
 };
 

@@ -33,7 +33,8 @@ struct ScanUpdate {
 
 /// @brief Computes the update of one scan against a map's voxel grid (the map is not modified).
 /// Parallel over rays (TBB); the result does not depend on the number of threads.
-/// @throw std::invalid_argument on an invalid config or scan.
+/// @throw InvalidArgumentError on an invalid config or scan; RefusedError when one scan would
+/// grow the map by more than IntegrationConfig::max_update_bytes.
 [[nodiscard]] ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                                            const IntegrationConfig& config);
 
@@ -51,7 +52,7 @@ void ApplyOccupancyUpdate(const ScanUpdate& update, openvdb::FloatGrid& occupanc
 /// @brief Integrates scans one by one into a map it does not own.
 class Integrator {
 public:
-    /// @throw std::invalid_argument on an invalid config.
+    /// @throw InvalidArgumentError on an invalid config.
     Integrator(core::VoxelMap& map, const IntegrationConfig& config);
 
     /// @brief ComputeScanUpdate then ApplyScanUpdate; returns the update it applied.
