@@ -178,17 +178,13 @@ TEST(RegistrationIntegrateAlignCli, StoresTheTransformAsTheSessionsAlignment) {
     EXPECT_NE(day2.notes.find("rmse_m"), std::string::npos) << day2.notes;
 }
 
-// The voxels session `name` saw occupied (its layer in every tile of the latest snapshot).
+// The voxels session `name` saw occupied (its layer file in every tile it touched).
 openvdb::BoolGrid::Ptr SessionVoxels(const fs::path& map, const std::string& name) {
     const store::MapStore store = store::MapStore::Open(map, store::MapStore::Access::kRead);
-    const int64_t id = store.FindSession(name);
     auto voxels = openvdb::BoolGrid::create(false);
-    for (const store::TileVersion& version : store.Latest().tiles) {
-        for (const store::SessionLayer& layer : store.ReadTile(version).layers) {
-            if (layer.session == id && layer.occupied) {
-                voxels->tree().topologyUnion(layer.occupied->tree());
-            }
-        }
+    for (const store::LayerFile& file : store.SessionLayers(store.FindSession(name))) {
+        const store::SessionLayer layer = store.ReadLayer(file);
+        if (layer.occupied) voxels->tree().topologyUnion(layer.occupied->tree());
     }
     return voxels;
 }
