@@ -17,6 +17,7 @@
 #include "strata/pipeline/Alignment.hpp"
 #include "strata/pipeline/Diff.hpp"
 #include "strata/pipeline/Export.hpp"
+#include "strata/pipeline/Info.hpp"
 #include "strata/pipeline/MapAccess.hpp"
 #include "strata/pipeline/Vehicles.hpp"
 #include "strata/store/MapStore.hpp"
@@ -290,6 +291,17 @@ void RegisterStoredMap(py::module_& m) {
              })
         .def("load", &StoredMap::Load, py::arg("as_of") = "")
         .def("sessions", &SessionList)
+        .def(
+            "info",
+            [](const StoredMap& self, const std::string& as_of) {
+                std::string text;
+                {
+                    py::gil_scoped_release release;
+                    text = pipeline::DescribeMap(self.Get(), as_of).dump();
+                }
+                return ParseJson(text);
+            },
+            py::arg("as_of") = "")
         .def("session_id",
              [](const StoredMap& self, const std::string& id_or_name) {
                  return self.Get().FindSession(id_or_name);

@@ -174,6 +174,13 @@ class Map:
         """The map's sessions, oldest first, as dicts (id, name, scans, points, ...)."""
         return self._impl.sessions()
 
+    def info(self, as_of=None) -> dict:
+        """What the map holds, with the keys of `strata info --json`: voxel_size_m, origin,
+        occupied_voxels, free_voxels, classes, extent_min/max, tiles, bytes by kind
+        (fused_current, fused_older, layers, products, catalog), disk_bytes, memory_bytes,
+        sessions, ...; of the newest commit, or right after session `as_of` (id or name)."""
+        return self._impl.info("" if as_of is None else str(as_of))
+
     def as_of(self, session) -> VoxelMap:
         """The map right after `session` (an id or a name) was committed, read-only."""
         return self._impl.load(str(session))

@@ -40,3 +40,25 @@ def test_kitti_00_from_numpy_equals_strata_integrate(tmp_path):
     run_strata("integrate", tmp_path / "theirs", "--kitti", sequence, "--frames", "0:2")
     with strata.Map.open(tmp_path / "theirs", read_only=True) as theirs:
         assert_same_voxels(ours, theirs.snapshot())
+
+
+def test_map_info_equals_strata_info_json(tmp_path, street_sequence):
+    import json
+    run_strata("integrate", tmp_path / "map", "--kitti", street_sequence, "--name", "first")
+    run_strata("integrate", tmp_path / "map", "--kitti", street_sequence, "--name", "second")
+    for as_of in (None, "first"):
+        args = ["info", tmp_path / "map", "--json"] + ([] if as_of is None else ["--as-of", as_of])
+        cli = run_strata(*args).stdout
+        expected = json.loads(cli[cli.index("{"):])
+        with strata.Map.open(tmp_path / "map", read_only=True) as m:
+            ours = m.info(as_of)
+        # What the directory holds on disk changes while a reader has SQLite's files open.
+        for d in (expected, ours):
+            d.pop("disk_bytes")
+            d["bytes"].pop("catalog")
+        assert ours == expected
+        assert ours["occupied_voxels"] > 1000
+        assert len(ours["sessions"]) == (2 if as_of is None else 1)
+    with strata.Map.open(tmp_path / "map", read_only=True) as m:
+        with pytest.raises(strata.NotFoundError, match="no session"):
+            m.info("third")

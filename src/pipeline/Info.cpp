@@ -1,0 +1,95 @@
+#include "strata/pipeline/Info.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+
+#include "strata/core/Labels.hpp"
+#include "strata/pipeline/MapAccess.hpp"
+
+namespace strata::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Bytes of every file under `dir` (whose name starts with `prefix`, when given).
+uint64_t DiskUse(const fs::path& dir, const std::string& prefix = "") {
+    uint64_t bytes = 0;
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(dir, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        std::error_code ignored;
+        if (!it->is_regular_file(ignored)) continue;
+        if (it->path().filename().string().rfind(prefix, 0) == 0) {
+            bytes += it->file_size(ignored);
+        }
+    }
+    return bytes;
+}
+
+}  // namespace
+
+nlohmann::json DescribeMap(const store::MapStore& store, const std::string& as_of) {
+    const store::Snapshot snapshot = SelectSnapshot(store, as_of);
+    const core::VoxelMap map = store.LoadMap(snapshot);
+    size_t occupied = 0, free = 0;
+    std::map<std::string, size_t> classes;
+    auto label = map.label->getConstAccessor();
+    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.0f) {
+            ++free;
+            continue;
+        }
+        ++occupied;
+        int32_t value = 0;
+        const bool labelled = label.probeValue(it.getCoord(), value);
+        ++classes[core::ClassName(labelled ? static_cast<core::SemanticClass>(value)
+                                           : core::SemanticClass::kUnknown)];
+    }
+    nlohmann::json j;
+    j["map"] = store.dir().string();
+    j["commit"] = snapshot.commit;
+    if (!as_of.empty()) j["as_of"] = as_of;
+    j["tile_size_m"] = store.settings().tile_size_m();
+    j["format_version"] = store.settings().format_version;
+    j["voxel_size_m"] = map.voxel_size;
+    j["origin"] = {map.origin.x(), map.origin.y(), map.origin.z()};
+    j["occupied_voxels"] = occupied;
+    j["free_voxels"] = free;
+    j["classes"] = classes;
+    const openvdb::CoordBBox box = map.occupancy->evalActiveVoxelBoundingBox();
+    if (!box.empty()) {
+        const Eigen::Vector3d lo = map.VoxelCenter(box.min()) -
+                                   Eigen::Vector3d::Constant(0.5 * map.voxel_size) + map.origin;
+        const Eigen::Vector3d hi = map.VoxelCenter(box.max()) +
+                                   Eigen::Vector3d::Constant(0.5 * map.voxel_size) + map.origin;
+        const auto mm = [](double v) { return std::round(v * 1e3) / 1e3; };
+        j["extent_min"] = {mm(lo.x()), mm(lo.y()), mm(lo.z())};
+        j["extent_max"] = {mm(hi.x()), mm(hi.y()), mm(hi.z())};
+    }
+    size_t memory = 0;
+    for (const auto& g : map.Grids()) memory += g->memUsage();
+    j["memory_bytes"] = memory;
+    const store::StorageBytes bytes = store.Bytes(snapshot);
+    j["tiles"] = snapshot.tiles.size();
+    j["tile_bytes"] = bytes.fused_current;  // the fused files this snapshot reads
+    j["tile_versions"] = store.TileFileCount();  // every fused version kept, history included
+    j["history_start_commit"] = store.HistoryStart();
+    j["bytes"] = {{"fused_current", bytes.fused_current},
+                  {"fused_older", bytes.fused_older},
+                  {"layers", bytes.layers},
+                  {"products", bytes.products},
+                  {"catalog", DiskUse(store.dir(), "catalog.sqlite")}};
+    j["disk_bytes"] = DiskUse(store.dir());  // catalog, all files, garbage
+    j["sessions"] = nlohmann::json::array();
+    for (const auto& s : snapshot.sessions) {
+        j["sessions"].push_back({{"id", s.id}, {"name", s.name}, {"source", s.source},
+                                 {"scans", s.scans}, {"points", s.points},
+                                 {"start_utc", s.start_utc}, {"end_utc", s.end_utc},
+                                 {"commit", s.commit}});
+    }
+    return j;
+}
+
+}  // namespace strata::pipeline
