@@ -14,6 +14,15 @@
 #include "strata/store/SessionWriter.hpp"
 
 namespace strata::bench {
+
+double CpuSeconds() {
+    timespec ts{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double Mb(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -24,12 +33,6 @@ constexpr double kMaxBytesRatio = 1.1;
 // Disk use grows linearly: the growth over the last quarter of the sessions, per session, at
 // most this much above the growth over the second quarter.
 constexpr double kMaxGrowthRatio = 1.1;
-
-double CpuSeconds() {
-    timespec ts{};
-    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 // Bytes this process read through read(2) so far (/proc/self/io rchar).
 uint64_t ReadChars() {
@@ -49,8 +52,6 @@ uint64_t DiskBytes(const fs::path& dir) {
     }
     return bytes;
 }
-
-double Mb(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
 
 struct Commit {
     uint64_t bytes = 0;

@@ -3,6 +3,7 @@
 // reading the current map reads, and the migration of a format-4 map. Each function prints its
 // markdown table and returns the targets it missed (empty: all held).
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -10,6 +11,12 @@
 #include "strata/core/Scan.hpp"
 
 namespace strata::bench {
+
+/// CPU seconds this process has used so far (all threads).
+[[nodiscard]] double CpuSeconds();
+
+/// Bytes as MB (1e6), for the tables.
+[[nodiscard]] double Mb(uint64_t bytes);
 
 struct SessionsConfig {
     size_t sessions = 50;

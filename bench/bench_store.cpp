@@ -40,6 +40,8 @@
 namespace {
 
 namespace fs = std::filesystem;
+using strata::bench::CpuSeconds;
+using strata::bench::Mb;
 using strata::bench::Clock;
 using strata::bench::Seconds;
 using strata::core::Scan;
@@ -83,12 +85,6 @@ struct StoreRun {
     WriterStats stats;  // summed over sessions; peak memory is the largest
 };
 
-double CpuSeconds() {
-    timespec ts{};
-    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 // Measures from construction to Stop().
 class Stopwatch {
 public:
@@ -104,8 +100,6 @@ double Median(std::vector<double> v) {
     const size_t n = v.size();
     return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
-
-double Mb(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
 
 // Half-open [begin, end) ranges of `n` scans cut into `k` consecutive slices of near-equal size.
 std::vector<std::pair<size_t, size_t>> Slices(size_t n, size_t k) {
