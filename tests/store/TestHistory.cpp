@@ -46,7 +46,9 @@ TEST(History, KeepLastDropsOlderSnapshotsAndKeepsTheRest) {
         if (commit >= latest - 2) {
             ExpectSameMap(map.LoadMap(map.At(commit)), fused);
         } else {
-            EXPECT_TRUE(ThrowsNaming<NotFoundError>([&] { (void)map.At(commit); }, "gc"));
+            // A copy: C++17 lambdas cannot capture a structured binding (clang refuses it).
+            const int64_t dropped = commit;
+            EXPECT_TRUE(ThrowsNaming<NotFoundError>([&] { (void)map.At(dropped); }, "gc"));
         }
     }
     EXPECT_TRUE(ThrowsNaming<NotFoundError>([&] { (void)map.AsOf(1); }, "no longer kept"));
