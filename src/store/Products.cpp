@@ -71,9 +71,10 @@ std::set<TileKey> TilesOf(const openvdb::GridPtrVec& grids, const MapSettings& s
 }
 
 std::vector<ProductRow> SelectRows(const detail::Database& db, const char* sql,
-                                   const std::string& kind) {
+                                   const std::string& kind, int64_t at_commit = 0) {
     Statement q(db, sql);
     q.Bind(1, kind);
+    if (at_commit != 0) q.Bind(2, at_commit);
     std::vector<ProductRow> out;
     while (q.Step()) out.push_back({q.Int(0), q.Int(1), q.Text(2), q.Text(3)});
     return out;
@@ -179,6 +180,17 @@ std::vector<ProductRow> MapStore::ProductRows(const std::string& kind) const {
                       "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
                       "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1) ORDER BY r.id",
                       kind);
+}
+
+std::vector<ProductRow> MapStore::ProductRowsAt(const std::string& kind, int64_t commit) const {
+    // The newest commit of the kind is found in `commits`, not among the rows: a commit that
+    // stored no row (no wall found) replaces the rows before it all the same.
+    return SelectRows(*impl_->db,
+                      "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
+                      "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
+                      "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1 AND id <= ?2) "
+                      "ORDER BY r.id",
+                      kind, commit);
 }
 
 std::vector<ProductRow> MapStore::ProductHistory(const std::string& kind) const {

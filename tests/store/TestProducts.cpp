@@ -107,6 +107,17 @@ TEST(Products, ANewKindIsStoredWithGridsRowsAndAViewNoStoreCodeNeeded) {
     // A session integrated later keeps the products as they were.
     (void)Write(map, Session(5, {1, 0, 0}));
     EXPECT_EQ(map.ProductRows("potholes").size(), 1u);
+    // A commit that stores no row replaces the rows before it for every reader after it, not
+    // only for the newest one; readers of earlier snapshots keep theirs.
+    const int64_t c2 = map.Latest().commit;
+    potholes.rows = {};
+    const int64_t c3 = map.CommitProduct(potholes);
+    EXPECT_TRUE(map.ProductRows("potholes").empty());
+    EXPECT_TRUE(map.ProductRowsAt("potholes", c3).empty());
+    ASSERT_EQ(map.ProductRowsAt("potholes", c2).size(), 1u);
+    EXPECT_NE(map.ProductRowsAt("potholes", c2)[0].json.find("\"lane\": 2"), std::string::npos);
+    EXPECT_EQ(map.ProductRowsAt("potholes", c1).size(), 2u);
+    EXPECT_TRUE(map.ProductRowsAt("potholes", c1 - 1).empty());
 }
 
 TEST(Products, BadKindsRowsAndGridsAreRefusedBeforeAnythingIsWritten) {

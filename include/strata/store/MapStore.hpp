@@ -93,6 +93,10 @@ public:
     int64_t CommitProduct(const ProductCommit& product);
     /// Rows of the newest commit of `kind` (empty when none).
     [[nodiscard]] std::vector<ProductRow> ProductRows(const std::string& kind) const;
+    /// Rows of the newest commit of `kind` at or before commit `commit` (what a reader of that
+    /// snapshot sees; empty when that commit of the kind stored no row, or there is none).
+    [[nodiscard]] std::vector<ProductRow> ProductRowsAt(const std::string& kind,
+                                                        int64_t commit) const;
     /// Every row of every commit of `kind`, oldest first.
     [[nodiscard]] std::vector<ProductRow> ProductHistory(const std::string& kind) const;
 

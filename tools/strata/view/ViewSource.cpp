@@ -108,21 +108,6 @@ json ChangeSetJson(const ChangeSetRow& r, const std::string& created_utc) {
             {"from", r.from}, {"to", r.to},         {"report", r.report}};
 }
 
-// The rows of `kind` a reader of commit `commit` sees: those of its newest commit of `kind` at
-// or before `commit` (a later commit of a kind replaces the earlier one's rows).
-std::vector<store::ProductRow> RowsAt(const store::MapStore& store, const std::string& kind,
-                                      int64_t commit) {
-    std::vector<store::ProductRow> rows = store.ProductHistory(kind);
-    int64_t newest = 0;
-    for (const store::ProductRow& r : rows) {
-        if (r.commit <= commit) newest = std::max(newest, r.commit);
-    }
-    rows.erase(std::remove_if(rows.begin(), rows.end(),
-                              [&](const store::ProductRow& r) { return r.commit != newest; }),
-               rows.end());
-    return rows;
-}
-
 template <typename GridT>
 typename GridT::ConstPtr Product(const openvdb::GridPtrVec& grids, const char* name) {
     for (const openvdb::GridBase::Ptr& grid : grids) {
@@ -256,10 +241,10 @@ std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::str
             s.sessions.push_back(SessionJson(session, removed_by > commit ? 0 : removed_by));
         }
     }
-    for (const store::ProductRow& r : RowsAt(s.store, "walls", commit)) {
+    for (const store::ProductRow& r : s.store.ProductRowsAt("walls", commit)) {
         s.walls.push_back(WallJson(RowObject(s.store, "walls", r), r.commit));
     }
-    for (const store::ProductRow& r : RowsAt(s.store, "vehicles", commit)) {
+    for (const store::ProductRow& r : s.store.ProductRowsAt("vehicles", commit)) {
         s.vehicles.push_back(VehicleJson(RowObject(s.store, "vehicles", r), r.commit));
     }
     for (const store::ProductRow& r : s.store.ProductHistory("change_sets")) {
