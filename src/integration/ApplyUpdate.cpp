@@ -1,27 +1,44 @@
 #include "ApplyUpdate.hpp"
 
 #include <openvdb/tree/LeafManager.h>
+#include <openvdb/tree/ValueAccessor.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <vector>
 
 namespace strata::integration::detail {
 namespace {
 
 // Adds `delta` to every voxel of `mask` (an unobserved voxel starts at log-odds 0), clamped to
-// [lo, hi]: OctoMap's updateNodeLogOdds. The mask's voxels are first activated in the tree
-// (topologyUnion, parallel; newly observed voxels take the background, 0, and active tiles under
-// the mask become leaves), then values are updated in parallel, one mask leaf per task.
+// [lo, hi]: OctoMap's updateNodeLogOdds. The leaves under the mask are made first, serially
+// (topology changes are not thread-safe; consecutive mask leaves share their internal nodes, so
+// one accessor finds each in a few steps; newly observed voxels take the background, 0, and an
+// active tile under the mask becomes a leaf), then every leaf is updated in parallel.
 void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float delta, float lo,
                 float hi) {
-    tree.topologyUnion(mask);
-    openvdb::tree::LeafManager<const openvdb::MaskTree> leaves(mask);
-    leaves.foreach([&](const openvdb::MaskTree::LeafNodeType& mask_leaf, size_t) {
-        float* values = tree.probeLeaf(mask_leaf.origin())->buffer().data();
-        for (auto on = mask_leaf.getValueMask().beginOn(); on; ++on) {
-            float& v = values[on.pos()];
-            v = std::clamp(v + delta, lo, hi);
-        }
-    });
+    std::vector<const openvdb::MaskTree::LeafNodeType*> masks;
+    masks.reserve(mask.leafCount());
+    for (auto it = mask.cbeginLeaf(); it; ++it) masks.push_back(it.getLeaf());
+    std::vector<openvdb::FloatTree::LeafNodeType*> leaves(masks.size());
+    {
+        openvdb::tree::ValueAccessor<openvdb::FloatTree> acc(tree);
+        for (size_t i = 0; i < masks.size(); ++i) leaves[i] = acc.touchLeaf(masks[i]->origin());
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, masks.size()),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          for (size_t i = range.begin(); i != range.end(); ++i) {
+                              const auto& on_mask = masks[i]->getValueMask();
+                              openvdb::FloatTree::LeafNodeType& leaf = *leaves[i];
+                              float* values = leaf.buffer().data();
+                              for (auto on = on_mask.beginOn(); on; ++on) {
+                                  float& v = values[on.pos()];
+                                  v = std::clamp(v + delta, lo, hi);
+                              }
+                              leaf.getValueMask() |= on_mask;
+                          }
+                      });
 }
 
 }  // namespace
