@@ -25,6 +25,9 @@ struct MapStore::Impl {
     [[nodiscard]] Snapshot SnapshotAt(int64_t commit) const;
     /// The id the next commit gets (files are named after it before the transaction).
     [[nodiscard]] int64_t NextCommitId() const;
+    /// True when a writer lock on the map is held through another open file (another process, or
+    /// another MapStore of this one): what a worker of a session checks.
+    [[nodiscard]] bool LockedByAnotherWriter() const;
     /// Removes files written for a commit that did not land.
     void RemoveFiles(const std::vector<std::string>& files) const;
 };

@@ -64,6 +64,21 @@ int TakeWriterLock(const fs::path& dir) {
     return fd;
 }
 
+}  // namespace
+
+bool MapStore::Impl::LockedByAnotherWriter() const {
+    const fs::path file = dir / kLockFile;
+    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;
+    // flock locks belong to open files: a shared lock on a new one fails while any other holds
+    // the exclusive lock, this process's own stores included.
+    const bool held = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    ::close(fd);
+    return held;
+}
+
+namespace {
+
 // What an interrupted Create leaves: the lock file, an empty tiles/, a half-built catalog.
 bool OnlyCreationLeftovers(const fs::path& dir) {
     std::error_code ec;

@@ -18,6 +18,7 @@
 #include "TileSplit.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/OccupancyMasks.hpp"
+#include "strata/integration/UpdateParts.hpp"
 
 namespace strata::store {
 namespace {
@@ -83,6 +84,10 @@ struct SessionWriter::State {
         return (it == last_versions.end() ? 0 : it->second) + 1;
     }
 
+    [[nodiscard]] bool Owns(const TileKey& key) const {
+        return !options.owns || options.owns(key);
+    }
+
     std::set<TileKey> TouchedTiles(const integration::ScanUpdate& update) const {
         std::set<TileKey> keys;
         for (const auto* tree : {update.free.get(), update.occupied.get()}) {
@@ -91,6 +96,50 @@ struct SessionWriter::State {
             }
         }
         return keys;
+    }
+
+    // Writes the files of every tile this writer changed and syncs them: resident dirty tiles
+    // now, evicted ones already were. Nothing else is written.
+    SessionFiles WriteOwnFiles() {
+        stats.peak_memory_bytes = std::max(stats.peak_memory_bytes, MemoryBytes());
+        std::set<TileKey> dirty;
+        for (const auto& [key, r] : resident) {
+            if (r.dirty) dirty.insert(key);
+        }
+        auto fused = detail::StealMapTiles(work, settings(), &dirty);
+        auto logodds = detail::StealTiles(*session, settings(), &dirty);
+        const std::vector<TileKey> keys(dirty.begin(), dirty.end());
+        for (const TileKey& key : keys) {
+            written_files.insert(detail::FusedFileName(key, NextVersion(key)));
+            written_files.insert(detail::LayerFileName(key, session_id));
+        }
+        std::vector<std::pair<TileVersion, LayerFile>> files(keys.size());
+        detail::ParallelFor(keys.size(), [&](size_t i) {
+            files[i] = WriteTile(keys[i], fused.at(keys[i]), *logodds.at(keys[i]));
+        });
+        for (const auto& [v, l] : files) Written(v, l);
+        for (const auto& [key, p] : pending) {
+            if (!dirty.count(key)) files.emplace_back(p.version, p.layer);
+        }
+        Hook("tiles_written");
+
+        std::set<fs::path> dirs;
+        for (const auto& [v, l] : files) dirs.insert(impl.TileDir(v.key));
+        for (const fs::path& dir : dirs) detail::SyncDirectory(dir);
+        detail::SyncDirectory(impl.dir / "tiles");
+        Hook("tiles_synced");
+        SessionFiles out;
+        for (const auto& [v, l] : files) {
+            out.versions.push_back(v);
+            if (!l.file.empty()) out.layers.push_back(l);
+        }
+        return out;
+    }
+
+    // The log-odds files served evictions only; a crash before this leaves them to gc.
+    void Finish() {
+        done = true;
+        for (const auto& [key, p] : pending) impl.RemoveFiles({p.logodds.file});
     }
 
     // What makes `key` resident: the pending version and the session's log-odds when an
@@ -225,7 +274,16 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
                              SessionOptions options)
     : state_(std::make_unique<State>(*store.impl_, store, config, std::move(options))) {
     State& s = *state_;
-    s.impl.RequireWriter("integrate");
+    if (s.options.worker_of_session > 0) {
+        // A worker writes files only; the process holding the lock commits them.
+        if (!s.impl.LockedByAnotherWriter()) {
+            throw InvalidArgumentError(s.impl.dir.string() +
+                                       ": a worker of a session needs the committing process to "
+                                       "hold the map's writer lock");
+        }
+    } else {
+        s.impl.RequireWriter("integrate");
+    }
     s.config.Validate();
     const std::vector<std::string> conflicts =
         detail::RuleConflicts(s.impl.settings.integration, s.config);
@@ -236,7 +294,8 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
                                    ": the integration settings differ from the rule the map was "
                                    "built with (" + what + ")");
     }
-    s.session_id = detail::NextSessionId(*s.impl.db);
+    s.session_id = s.options.worker_of_session > 0 ? s.options.worker_of_session
+                                                   : detail::NextSessionId(*s.impl.db);
     for (const TileVersion& v : detail::ReadTiles(*s.impl.db, detail::LatestCommit(*s.impl.db))) {
         s.committed[v.key] = v;
     }
@@ -268,62 +327,89 @@ integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
         aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
         update = integration::ComputeScanUpdate(aligned, s.work, s.config);
     }
-    const std::set<TileKey> keys = s.TouchedTiles(update);
+    Apply(update);
+    AddScan(RecordOf(scan, update));
+    return update;
+}
+
+void SessionWriter::Apply(const integration::ScanUpdate& update) {
+    State& s = *state_;
+    if (s.done) throw InvalidArgumentError("the session is committed already");
+    // A writer that keeps only some tiles applies only their part (updates act voxel by voxel).
+    std::optional<integration::ScanUpdate> part;
+    if (s.options.owns) {
+        part = integration::SelectUpdate(update, [&](const openvdb::Coord& leaf) {
+            return s.options.owns(s.settings().TileOf(leaf));
+        });
+    }
+    const integration::ScanUpdate& own = part ? *part : update;
+    const std::set<TileKey> keys = s.TouchedTiles(own);
     s.MakeResident(keys);
-    tbb::parallel_invoke([&] { integration::ApplyScanUpdate(update, s.work, s.config); },
-                         [&] { integration::ApplyOccupancyUpdate(update, *s.session, s.config); });
+    tbb::parallel_invoke([&] { integration::ApplyScanUpdate(own, s.work, s.config); },
+                         [&] { integration::ApplyOccupancyUpdate(own, *s.session, s.config); });
     ++s.clock;
     for (const TileKey& key : keys) {
         State::Resident& r = s.resident.at(key);
         r.dirty = true;
         r.last_use = s.clock;
     }
-    ScanRecord record;
+    s.Evict(keys);
+}
+
+void SessionWriter::AddScan(const ScanRecord& scan) {
+    State& s = *state_;
+    if (s.done) throw InvalidArgumentError("the session is committed already");
+    ScanRecord record = scan;
     record.index = s.scans.size();
+    s.scans.push_back(record);
+    s.points += record.points;
+}
+
+ScanRecord SessionWriter::RecordOf(const core::Scan& scan, const integration::ScanUpdate& update) {
+    ScanRecord record;
     record.time_s = scan.time_s;
     record.pose = scan.T_world_sensor;
     record.points = update.points - update.dropped;
     record.source = scan.source;
-    s.scans.push_back(record);
-    s.points += record.points;
-    s.Evict(keys);
-    return update;
+    return record;
 }
 
-SessionRecord SessionWriter::Commit() {
+SessionFiles SessionWriter::WriteFiles() {
     State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
+    SessionFiles files = s.WriteOwnFiles();
+    files.stats = s.stats;
+    s.Finish();  // the committer owns the files from here
+    return files;
+}
+
+SessionRecord SessionWriter::Commit(const std::vector<SessionFiles>& workers) {
+    State& s = *state_;
+    if (s.done) throw InvalidArgumentError("the session is committed already");
+    if (s.options.worker_of_session > 0) {
+        throw InvalidArgumentError("a worker of a session writes its files (WriteFiles); the "
+                                   "process holding the writer lock commits them");
+    }
     const auto start = std::chrono::steady_clock::now();
-    s.stats.peak_memory_bytes = std::max(s.stats.peak_memory_bytes, s.MemoryBytes());
-
-    // Every tile this session changed gets one new fused version and this session's layers:
-    // resident dirty tiles are written now, evicted ones already were. Nothing else is written.
-    std::set<TileKey> dirty;
-    for (const auto& [key, r] : s.resident) {
-        if (r.dirty) dirty.insert(key);
+    // On failure the workers' files go with this writer's: nothing will reference them.
+    for (const SessionFiles& w : workers) {
+        for (const TileVersion& v : w.versions) s.written_files.insert(v.file);
+        for (const LayerFile& l : w.layers) s.written_files.insert(l.file);
     }
-    auto fused = detail::StealMapTiles(s.work, s.settings(), &dirty);
-    auto logodds = detail::StealTiles(*s.session, s.settings(), &dirty);
-    const std::vector<TileKey> keys(dirty.begin(), dirty.end());
-    for (const TileKey& key : keys) {
-        s.written_files.insert(detail::FusedFileName(key, s.NextVersion(key)));
-        s.written_files.insert(detail::LayerFileName(key, s.session_id));
+    SessionFiles files = s.WriteOwnFiles();
+    std::set<TileKey> tiles;
+    for (const TileVersion& v : files.versions) tiles.insert(v.key);
+    for (const SessionFiles& w : workers) {
+        for (const TileVersion& v : w.versions) {
+            if (!tiles.insert(v.key).second) {
+                throw InvalidArgumentError("tile " + std::to_string(v.key.x) + "_" +
+                                           std::to_string(v.key.y) +
+                                           " has two writers in one session");
+            }
+            files.versions.push_back(v);
+        }
+        for (const LayerFile& l : w.layers) files.layers.push_back(l);
     }
-    std::vector<std::pair<TileVersion, LayerFile>> files(keys.size());
-    detail::ParallelFor(keys.size(), [&](size_t i) {
-        files[i] = s.WriteTile(keys[i], fused.at(keys[i]), *logodds.at(keys[i]));
-    });
-    for (const auto& [v, l] : files) s.Written(v, l);
-    for (const auto& [key, p] : s.pending) {
-        if (!dirty.count(key)) files.emplace_back(p.version, p.layer);
-    }
-    s.Hook("tiles_written");
-
-    std::set<fs::path> dirs;
-    for (const auto& [v, l] : files) dirs.insert(s.impl.TileDir(v.key));
-    for (const fs::path& dir : dirs) detail::SyncDirectory(dir);
-    detail::SyncDirectory(s.impl.dir / "tiles");
-    s.Hook("tiles_synced");
 
     SessionRecord record;
     record.id = s.session_id;
@@ -342,17 +428,15 @@ SessionRecord SessionWriter::Commit() {
         record.commit = detail::InsertCommit(db, "integrate", s.session_id);
         detail::InsertSession(db, record);
         detail::InsertScans(db, s.session_id, s.scans);
-        for (auto& [v, l] : files) {
+        for (TileVersion& v : files.versions) {
             v.commit = record.commit;
             detail::InsertTileVersion(db, v);
-            if (!l.file.empty()) detail::InsertLayer(db, l);
         }
+        for (const LayerFile& l : files.layers) detail::InsertLayer(db, l);
         s.Hook("catalog_written");
         tx.Commit();
     }
-    s.done = true;
-    // The log-odds files served evictions only; a crash before this leaves them to gc.
-    for (const auto& [key, p] : s.pending) s.impl.RemoveFiles({p.logodds.file});
+    s.Finish();
     s.stats.commit_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return record;

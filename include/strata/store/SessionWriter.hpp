@@ -3,6 +3,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "strata/core/Scan.hpp"
 #include "strata/integration/Integrator.hpp"
@@ -20,6 +21,15 @@ struct SessionOptions {
     /// Tiles in memory are evicted (written to their next version, read back when a later scan
     /// touches them) to stay under this many bytes; 0 keeps every touched tile in memory.
     size_t memory_budget_bytes = 0;
+    /// The tiles this writer keeps (empty: every tile). When several processes share a session
+    /// (`mpirun`, docs/scale.md), each keeps its own and leaves the rest of every update to
+    /// their owners.
+    std::function<bool(const TileKey&)> owns;
+    /// Set in a process that writes its share of a session another process commits: the
+    /// session's id, from the committer's writer. The map may then be opened for reading (the
+    /// committer holds the writer lock; that is checked); WriteFiles ends its work, Commit is
+    /// refused.
+    int64_t worker_of_session = 0;
     /// For fault-injection tests: called at each step of Commit ("tiles_written",
     /// "tiles_synced", "catalog_written" inside the open transaction); a throw aborts the commit
     /// there.
@@ -35,6 +45,14 @@ struct WriterStats {
     uint64_t bytes_written = 0;  ///< fused and layer files together
     size_t peak_memory_bytes = 0;  ///< largest working set seen (grids of loaded tiles)
     double commit_seconds = 0.0;
+};
+
+/// @brief What one writer of a session wrote: its tiles' files, written and synced, for the
+/// commit.
+struct SessionFiles {
+    std::vector<TileVersion> versions;
+    std::vector<LayerFile> layers;
+    WriterStats stats;
 };
 
 /// @brief Integrates one session into a map opened for writing, tile by tile, and commits it:
@@ -56,10 +74,25 @@ public:
     SessionWriter(const SessionWriter&) = delete;
     SessionWriter& operator=(const SessionWriter&) = delete;
 
-    /// Integrates one scan (and records its pose, time and source file in the session's scans).
+    /// Integrates one scan: ComputeScanUpdate, Apply, AddScan; returns the whole update.
     integration::ScanUpdate Integrate(const core::Scan& scan);
-    /// Writes and records the session; the writer cannot be used afterwards.
-    SessionRecord Commit();
+    /// Applies the part of an update (computed here or by another process) that falls in the
+    /// tiles this writer keeps. Updates must come in the order of their scans.
+    void Apply(const integration::ScanUpdate& update);
+    /// Records the next scan of the session (pose, time, source file, points kept): one writer
+    /// records every scan, in order, whichever process integrated it.
+    void AddScan(const ScanRecord& scan);
+    /// The record of a scan integrated with `update` (its index is given by AddScan).
+    [[nodiscard]] static ScanRecord RecordOf(const core::Scan& scan,
+                                             const integration::ScanUpdate& update);
+
+    /// A worker's end: writes and syncs the files of its tiles and hands them to the committer
+    /// (who owns them from here: they stay on disk if this writer is destroyed).
+    [[nodiscard]] SessionFiles WriteFiles();
+    /// Writes this writer's files, then records them, the `workers`' files, the session and its
+    /// scans in one transaction; the writer cannot be used afterwards. If the commit fails, the
+    /// workers' files are removed with this writer's. A tile may have one writer only.
+    SessionRecord Commit(const std::vector<SessionFiles>& workers = {});
 
     [[nodiscard]] int64_t session_id() const;
     [[nodiscard]] const WriterStats& stats() const;

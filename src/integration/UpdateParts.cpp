@@ -1,0 +1,177 @@
+#include "strata/integration/UpdateParts.hpp"
+
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+#include "strata/core/Error.hpp"
+
+namespace strata::integration {
+namespace {
+
+using MaskLeaf = openvdb::MaskTree::LeafNodeType;
+constexpr uint32_t kMagic = 0x31555453;  // "STU1": strata update, version 1
+constexpr size_t kMaskWords = MaskLeaf::NodeMaskType::WORD_COUNT;
+
+openvdb::MaskTree::Ptr SelectLeaves(const openvdb::MaskTree& tree, const LeafFilter& keep) {
+    auto out = std::make_shared<openvdb::MaskTree>();
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+        if (keep(leaf->origin())) out->addLeaf(new MaskLeaf(*leaf));
+    }
+    return out;
+}
+
+openvdb::Coord LeafOrigin(const openvdb::Coord& ijk) {
+    return {ijk.x() & ~7, ijk.y() & ~7, ijk.z() & ~7};
+}
+
+// Appends trivially copyable values in the machine's byte order (strata runs on little-endian
+// x86-64 and ARM64 only; the magic number refuses anything else).
+class Writer {
+public:
+    template <typename T>
+    void Put(const T& value) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+    }
+    void PutTree(const openvdb::MaskTree& tree) {
+        Put(static_cast<uint64_t>(tree.leafCount()));
+        for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+            Put(leaf->origin().x());
+            Put(leaf->origin().y());
+            Put(leaf->origin().z());
+            const auto& mask = leaf->getValueMask();
+            for (size_t w = 0; w < kMaskWords; ++w) Put(mask.getWord<uint64_t>(w));
+        }
+    }
+    std::string Take() { return std::move(bytes_); }
+
+private:
+    std::string bytes_;
+};
+
+class Reader {
+public:
+    Reader(std::string_view bytes, const std::string& what) : bytes_(bytes), what_(what) {}
+
+    template <typename T>
+    T Get() {
+        if (bytes_.size() - pos_ < sizeof(T)) Fail("truncated");
+        T value;
+        std::memcpy(&value, bytes_.data() + pos_, sizeof(T));
+        pos_ += sizeof(T);
+        return value;
+    }
+    // Three reads in order (the arguments of one constructor call are evaluated in any order).
+    openvdb::Coord GetCoord() {
+        const auto x = Get<int32_t>();
+        const auto y = Get<int32_t>();
+        const auto z = Get<int32_t>();
+        return {x, y, z};
+    }
+    // A count of records of `record_bytes` each that the remaining bytes can hold.
+    size_t Count(size_t record_bytes) {
+        const auto n = Get<uint64_t>();
+        if (n > (bytes_.size() - pos_) / record_bytes) Fail("truncated");
+        return static_cast<size_t>(n);
+    }
+    openvdb::MaskTree::Ptr GetTree() {
+        auto tree = std::make_shared<openvdb::MaskTree>();
+        const size_t n = Count(3 * sizeof(int32_t) + kMaskWords * sizeof(uint64_t));
+        for (size_t i = 0; i < n; ++i) {
+            const openvdb::Coord origin = GetCoord();
+            if (LeafOrigin(origin) != origin) Fail("a leaf origin is not a multiple of 8");
+            if (tree->probeConstLeaf(origin)) Fail("a leaf appears twice");
+            auto* leaf = new MaskLeaf(origin, false);
+            for (size_t w = 0; w < kMaskWords; ++w) {
+                leaf->getValueMask().getWord<uint64_t>(w) = Get<uint64_t>();
+            }
+            tree->addLeaf(leaf);
+        }
+        return tree;
+    }
+    void End() const {
+        if (pos_ != bytes_.size()) Fail("trailing bytes");
+    }
+    [[noreturn]] void Fail(const char* problem) const {
+        throw FormatError(what_ + ": not a scan update (" + problem + ")");
+    }
+
+private:
+    std::string_view bytes_;
+    const std::string& what_;
+    size_t pos_ = 0;
+};
+
+}  // namespace
+
+ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep) {
+    ScanUpdate part;
+    part.free = SelectLeaves(*update.free, keep);
+    part.occupied = SelectLeaves(*update.occupied, keep);
+    // Groups come sorted by voxel, so the voxels of one leaf mostly follow each other.
+    openvdb::Coord last(std::numeric_limits<int32_t>::max());
+    bool kept = false;
+    for (const EndpointGroup& g : update.endpoints) {
+        const openvdb::Coord origin = LeafOrigin(g.ijk);
+        if (origin != last) {
+            last = origin;
+            kept = keep(origin);
+        }
+        if (kept) part.endpoints.push_back(g);
+    }
+    part.points = update.points;
+    part.dropped = update.dropped;
+    part.clipped = update.clipped;
+    return part;
+}
+
+std::string EncodeUpdate(const ScanUpdate& update) {
+    Writer w;
+    w.Put(kMagic);
+    w.Put(static_cast<uint64_t>(update.points));
+    w.Put(static_cast<uint64_t>(update.dropped));
+    w.Put(static_cast<uint64_t>(update.clipped));
+    w.PutTree(*update.free);
+    w.PutTree(*update.occupied);
+    w.Put(static_cast<uint64_t>(update.endpoints.size()));
+    for (const EndpointGroup& g : update.endpoints) {
+        w.Put(g.ijk.x());
+        w.Put(g.ijk.y());
+        w.Put(g.ijk.z());
+        w.Put(g.points);
+        w.Put(static_cast<uint8_t>(g.label));
+        w.Put(g.offset_sum.x());
+        w.Put(g.offset_sum.y());
+        w.Put(g.offset_sum.z());
+    }
+    return w.Take();
+}
+
+ScanUpdate DecodeUpdate(std::string_view bytes, const std::string& what) {
+    Reader r(bytes, what);
+    if (r.Get<uint32_t>() != kMagic) r.Fail("unknown version");
+    ScanUpdate update;
+    update.points = static_cast<size_t>(r.Get<uint64_t>());
+    update.dropped = static_cast<size_t>(r.Get<uint64_t>());
+    update.clipped = static_cast<size_t>(r.Get<uint64_t>());
+    update.free = r.GetTree();
+    update.occupied = r.GetTree();
+    const size_t groups = r.Count(4 * sizeof(int32_t) + 1 + 3 * sizeof(double));
+    update.endpoints.resize(groups);
+    for (EndpointGroup& g : update.endpoints) {
+        g.ijk = r.GetCoord();
+        g.points = r.Get<int32_t>();
+        const auto label = r.Get<uint8_t>();
+        if (label >= core::kNumClasses) r.Fail("a class out of range");
+        if (g.points <= 0) r.Fail("an endpoint group without points");
+        g.label = static_cast<core::SemanticClass>(label);
+        g.offset_sum.x() = r.Get<double>();
+        g.offset_sum.y() = r.Get<double>();
+        g.offset_sum.z() = r.Get<double>();
+    }
+    r.End();
+    return update;
+}
+
+}  // namespace strata::integration
