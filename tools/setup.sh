@@ -27,6 +27,7 @@ packages=(
   libcpp-httplib-dev libjs-three                     # strata view: its server, three.js
   chromium python3-pytest python3-websocket          # strata view's browser tests
   clang-format              # tools/format.sh (.ci/run checks the formatting)
+  libopenmpi-dev openmpi-bin              # mpirun strata ... (docs/scale.md)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, docs/python.md)
   python3-matplotlib                      # docs/python.md's plotting example (tested)
 )

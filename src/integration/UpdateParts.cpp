@@ -27,7 +27,7 @@ openvdb::Coord LeafOrigin(const openvdb::Coord& ijk) {
 
 // Appends trivially copyable values in the machine's byte order (strata runs on little-endian
 // x86-64 and ARM64 only; the magic number refuses anything else).
-class Writer {
+class UpdateWriter {
 public:
     template <typename T>
     void Put(const T& value) {
@@ -50,9 +50,9 @@ private:
     std::string bytes_;
 };
 
-class Reader {
+class UpdateReader {
 public:
-    Reader(std::string_view bytes, const std::string& what) : bytes_(bytes), what_(what) {}
+    UpdateReader(std::string_view bytes, const std::string& what) : bytes_(bytes), what_(what) {}
 
     template <typename T>
     T Get() {
@@ -127,7 +127,7 @@ ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep) {
 }
 
 std::string EncodeUpdate(const ScanUpdate& update) {
-    Writer w;
+    UpdateWriter w;
     w.Put(kMagic);
     w.Put(static_cast<uint64_t>(update.points));
     w.Put(static_cast<uint64_t>(update.dropped));
@@ -149,7 +149,7 @@ std::string EncodeUpdate(const ScanUpdate& update) {
 }
 
 ScanUpdate DecodeUpdate(std::string_view bytes, const std::string& what) {
-    Reader r(bytes, what);
+    UpdateReader r(bytes, what);
     if (r.Get<uint32_t>() != kMagic) r.Fail("unknown version");
     ScanUpdate update;
     update.points = static_cast<size_t>(r.Get<uint64_t>());

@@ -1,0 +1,59 @@
+#include "strata/pipeline/Ranks.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "MpiTest.hpp"
+#include "strata/core/Error.hpp"
+
+namespace strata::pipeline {
+namespace {
+
+using test::TestRanks;
+
+std::string Message(int from, int to) {
+    // Sizes differ by pair (and one is empty) so that counts and offsets are exercised.
+    return std::string(static_cast<size_t>((from * 7 + to * 3) % 5), 'x') + std::to_string(from) +
+           ">" + std::to_string(to);
+}
+
+TEST(Ranks, AreTheRanksMpirunStarted) {
+    // CTest's mpirun entries say how many ranks they start: a build that fell back to one
+    // process per copy would otherwise pass every test N times.
+    const char* expected = std::getenv("STRATA_TEST_RANKS");
+    EXPECT_EQ(TestRanks().size(), expected ? std::atoi(expected) : 1);
+    EXPECT_EQ(TestRanks().root(), TestRanks().rank() == 0);
+}
+
+TEST(Ranks, ExchangeDeliversEveryMessageToItsRankBySender) {
+    const Ranks& ranks = TestRanks();
+    std::vector<std::string> out;
+    for (int to = 0; to < ranks.size(); ++to) out.push_back(Message(ranks.rank(), to));
+    const std::vector<std::string> in = ranks.Exchange(out);
+    ASSERT_EQ(in.size(), static_cast<size_t>(ranks.size()));
+    for (int from = 0; from < ranks.size(); ++from) {
+        EXPECT_EQ(in[static_cast<size_t>(from)], Message(from, ranks.rank()));
+    }
+    EXPECT_THROW((void)ranks.Exchange({}), InvalidArgumentError);
+}
+
+TEST(Ranks, GatherBroadcastAndAgreement) {
+    const Ranks& ranks = TestRanks();
+    const std::vector<std::string> all = ranks.Gather(std::string(ranks.rank(), 'r'));
+    if (ranks.root()) {
+        ASSERT_EQ(all.size(), static_cast<size_t>(ranks.size()));
+        for (int r = 0; r < ranks.size(); ++r) EXPECT_EQ(all[static_cast<size_t>(r)].size(), static_cast<size_t>(r));
+    } else {
+        EXPECT_TRUE(all.empty());
+    }
+    EXPECT_EQ(ranks.Broadcast(ranks.root() ? "from rank 0" : "ignored"), "from rank 0");
+    EXPECT_TRUE(ranks.AllOk(true));
+    // One rank failing is every rank's answer.
+    EXPECT_EQ(ranks.AllOk(ranks.rank() != ranks.size() - 1), false);
+}
+
+}  // namespace
+}  // namespace strata::pipeline
