@@ -317,19 +317,21 @@ int64_t SessionWriter::session_id() const { return state_->session_id; }
 const WriterStats& SessionWriter::stats() const { return state_->stats; }
 
 integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
-    State& s = *state_;
-    if (s.done) throw InvalidArgumentError("the session is committed already");
-    integration::ScanUpdate update;
-    if (s.options.alignment.isIdentity()) {
-        update = integration::ComputeScanUpdate(scan, s.work, s.config);
-    } else {
-        core::Scan aligned = scan;
-        aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
-        update = integration::ComputeScanUpdate(aligned, s.work, s.config);
-    }
+    integration::ScanUpdate update = Compute(scan);
     Apply(update);
     AddScan(RecordOf(scan, update));
     return update;
+}
+
+integration::ScanUpdate SessionWriter::Compute(const core::Scan& scan) const {
+    const State& s = *state_;
+    if (s.done) throw InvalidArgumentError("the session is committed already");
+    if (s.options.alignment.isIdentity()) {
+        return integration::ComputeScanUpdate(scan, s.work, s.config);
+    }
+    core::Scan aligned = scan;
+    aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
+    return integration::ComputeScanUpdate(aligned, s.work, s.config);
 }
 
 void SessionWriter::Apply(const integration::ScanUpdate& update) {

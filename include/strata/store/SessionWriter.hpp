@@ -74,8 +74,11 @@ public:
     SessionWriter(const SessionWriter&) = delete;
     SessionWriter& operator=(const SessionWriter&) = delete;
 
-    /// Integrates one scan: ComputeScanUpdate, Apply, AddScan; returns the whole update.
+    /// Integrates one scan: Compute, Apply, AddScan; returns the whole update.
     integration::ScanUpdate Integrate(const core::Scan& scan);
+    /// The update of one scan (moved by the session's alignment) against this writer's map,
+    /// not applied: what a process that shares the session computes for the others.
+    [[nodiscard]] integration::ScanUpdate Compute(const core::Scan& scan) const;
     /// Applies the part of an update (computed here or by another process) that falls in the
     /// tiles this writer keeps. Updates must come in the order of their scans.
     void Apply(const integration::ScanUpdate& update);

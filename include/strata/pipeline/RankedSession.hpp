@@ -1,0 +1,51 @@
+#pragma once
+// One session integrated by every rank of a command (docs/scale.md, "Integrate"): the same map,
+// bit for bit, whatever the number of ranks.
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+#include "strata/core/Scan.hpp"
+#include "strata/integration/IntegrationConfig.hpp"
+#include "strata/pipeline/Ranks.hpp"
+#include "strata/store/MapStore.hpp"
+#include "strata/store/SessionWriter.hpp"
+
+namespace strata::pipeline {
+
+/// @brief The rank that keeps tile `key` among `ranks` ranks: a hash of the key, so that
+/// neighbouring tiles (a street's) spread over the ranks.
+[[nodiscard]] int TileOwner(const store::TileKey& key, int ranks);
+
+/// @brief What a ranked session wrote, summed over ranks.
+struct RankedSessionResult {
+    store::SessionRecord session;  ///< as committed (every rank gets it)
+    store::WriterStats stats;      ///< summed over ranks (peak memory: the largest rank's)
+};
+
+/// @brief Integrates scans 0..scans-1 as one session of `map` on every rank of `ranks`: rank r
+/// reads and computes the updates of scans r, r + N, ...; each update is cut by tile owner and
+/// every rank applies, in scan order, the parts in its own tiles; rank 0 commits every rank's
+/// files in one transaction once all are synced. Every rank calls it with the same arguments;
+/// `map` is open for writing on rank 0 (first) and for reading on the others (OpenOnRanks).
+/// `progress` (may be empty) is called on rank 0 with the number of scans done.
+/// @throw what any rank threw, on every rank ("rank K: ..." when another rank's); the map then
+/// stays at its last commit.
+RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
+                                     const std::function<core::Scan(size_t)>& read,
+                                     const integration::IntegrationConfig& config,
+                                     store::SessionOptions options, const Ranks& ranks,
+                                     const std::function<void(size_t)>& progress = {});
+
+/// @brief Opens the map on every rank: `open_root` on rank 0 (for writing; it may create or
+/// migrate the map), then `dir` for reading on the others once rank 0 succeeded.
+/// @throw what rank 0 threw, on every rank.
+[[nodiscard]] store::MapStore OpenOnRanks(const std::filesystem::path& dir, const Ranks& ranks,
+                                          const std::function<store::MapStore()>& open_root);
+
+/// @brief Runs `step` on every rank; if it throws on any, every rank throws: its own error, or
+/// "rank K: <message>" of the lowest failing rank, of the same kind where the kind is known.
+void OnEveryRank(const Ranks& ranks, const std::function<void()>& step);
+
+}  // namespace strata::pipeline
