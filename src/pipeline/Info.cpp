@@ -6,7 +6,9 @@
 #include <map>
 
 #include "strata/core/Labels.hpp"
+#include "strata/core/ParallelFor.hpp"
 #include "strata/pipeline/MapAccess.hpp"
+#include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -28,25 +30,55 @@ uint64_t DiskUse(const fs::path& dir, const std::string& prefix = "") {
     return bytes;
 }
 
+// What one tile's fused grids hold; tiles are summed, so that no more than a few tiles are in
+// memory at once whatever the size of the map.
+struct TileCounts {
+    size_t occupied = 0;
+    size_t free = 0;
+    std::map<std::string, size_t> classes;
+    openvdb::CoordBBox box;
+    size_t memory = 0;
+};
+
+TileCounts CountTile(const core::VoxelMap& map) {
+    TileCounts c;
+    auto label = map.label->getConstAccessor();
+    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.0f) {
+            ++c.free;
+            continue;
+        }
+        ++c.occupied;
+        int32_t value = 0;
+        const bool labelled = label.probeValue(it.getCoord(), value);
+        ++c.classes[core::ClassName(labelled ? static_cast<core::SemanticClass>(value)
+                                             : core::SemanticClass::kUnknown)];
+    }
+    c.box = map.occupancy->evalActiveVoxelBoundingBox();
+    for (const auto& g : map.Grids()) c.memory += g->memUsage();
+    return c;
+}
+
 }  // namespace
 
 nlohmann::json DescribeMap(const store::MapStore& store, const std::string& as_of) {
     const store::Snapshot snapshot = SelectSnapshot(store, as_of);
-    const core::VoxelMap map = store.LoadMap(snapshot);
-    size_t occupied = 0, free = 0;
-    std::map<std::string, size_t> classes;
-    auto label = map.label->getConstAccessor();
-    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
-        if (*it <= 0.0f) {
-            ++free;
-            continue;
-        }
-        ++occupied;
-        int32_t value = 0;
-        const bool labelled = label.probeValue(it.getCoord(), value);
-        ++classes[core::ClassName(labelled ? static_cast<core::SemanticClass>(value)
-                                           : core::SemanticClass::kUnknown)];
+    // Tile by tile, nothing cached: each tile is read, counted and dropped.
+    const store::TileReader reader(store, snapshot, 0);
+    const std::vector<store::TileKey> keys = reader.Tiles();
+    std::vector<TileCounts> tiles(keys.size());
+    core::ParallelFor(keys.size(), [&](size_t i) {
+        if (const auto tile = reader.Fused(keys[i])) tiles[i] = CountTile(*tile);
+    });
+    TileCounts all;
+    for (const TileCounts& t : tiles) {
+        all.occupied += t.occupied;
+        all.free += t.free;
+        for (const auto& [name, n] : t.classes) all.classes[name] += n;
+        all.box.expand(t.box);
+        all.memory += t.memory;
     }
+    const core::VoxelMap map = store.EmptyMap();
     nlohmann::json j;
     j["map"] = store.dir().string();
     j["commit"] = snapshot.commit;
@@ -55,22 +87,21 @@ nlohmann::json DescribeMap(const store::MapStore& store, const std::string& as_o
     j["format_version"] = store.settings().format_version;
     j["voxel_size_m"] = map.voxel_size;
     j["origin"] = {map.origin.x(), map.origin.y(), map.origin.z()};
-    j["occupied_voxels"] = occupied;
-    j["free_voxels"] = free;
-    j["classes"] = classes;
-    const openvdb::CoordBBox box = map.occupancy->evalActiveVoxelBoundingBox();
-    if (!box.empty()) {
-        const Eigen::Vector3d lo = map.VoxelCenter(box.min()) -
+    j["occupied_voxels"] = all.occupied;
+    j["free_voxels"] = all.free;
+    j["classes"] = all.classes;
+    if (!all.box.empty()) {
+        const Eigen::Vector3d lo = map.VoxelCenter(all.box.min()) -
                                    Eigen::Vector3d::Constant(0.5 * map.voxel_size) + map.origin;
-        const Eigen::Vector3d hi = map.VoxelCenter(box.max()) +
+        const Eigen::Vector3d hi = map.VoxelCenter(all.box.max()) +
                                    Eigen::Vector3d::Constant(0.5 * map.voxel_size) + map.origin;
         const auto mm = [](double v) { return std::round(v * 1e3) / 1e3; };
         j["extent_min"] = {mm(lo.x()), mm(lo.y()), mm(lo.z())};
         j["extent_max"] = {mm(hi.x()), mm(hi.y()), mm(hi.z())};
     }
-    size_t memory = 0;
-    for (const auto& g : map.Grids()) memory += g->memUsage();
-    j["memory_bytes"] = memory;
+    // The grids' memory summed over tiles (each tile's own tree nodes): what the fused map
+    // needs in memory at most, not what this command used.
+    j["memory_bytes"] = all.memory;
     const store::StorageBytes bytes = store.Bytes(snapshot);
     j["tiles"] = snapshot.tiles.size();
     j["tile_bytes"] = bytes.fused_current;  // the fused files this snapshot reads

@@ -6,9 +6,9 @@
 #include <sstream>
 
 #include "Catalog.hpp"
-#include "Parallel.hpp"
 #include "TileFile.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/ParallelFor.hpp"
 
 namespace strata::store::detail {
 namespace {
@@ -113,7 +113,7 @@ Format5Files WriteFormat5Files(const Database& db, const fs::path& map_dir) {
     const std::vector<std::pair<TileKey, std::vector<TileVersion>>> tiles(by_tile.begin(),
                                                                           by_tile.end());
     std::vector<Format5Files> parts(tiles.size());
-    ParallelFor(tiles.size(), [&](size_t i) {
+    core::ParallelFor(tiles.size(), [&](size_t i) {
         SplitTile(tiles[i].second, commits, map_dir, parts[i]);
     });
     Format5Files out;

@@ -7,11 +7,11 @@
 
 #include "Catalog.hpp"
 #include "MapStoreImpl.hpp"
-#include "Parallel.hpp"
 #include "Schema.hpp"
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/ParallelFor.hpp"
 
 namespace strata::store {
 namespace {
@@ -206,7 +206,7 @@ core::VoxelMap MapStore::EmptyMap() const {
 
 core::VoxelMap MapStore::LoadMap(const Snapshot& snapshot) const {
     std::vector<core::VoxelMap> tiles(snapshot.tiles.size());
-    detail::ParallelFor(tiles.size(), [&](size_t i) { tiles[i] = ReadFused(snapshot.tiles[i]); });
+    core::ParallelFor(tiles.size(), [&](size_t i) { tiles[i] = ReadFused(snapshot.tiles[i]); });
     core::VoxelMap map = EmptyMap();
     for (core::VoxelMap& tile : tiles) detail::MergeMap(map, tile);
     return map;

@@ -8,10 +8,10 @@
 
 #include "Catalog.hpp"
 #include "MapStoreImpl.hpp"
-#include "Parallel.hpp"
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/ParallelFor.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/store/MapStore.hpp"
 
@@ -97,7 +97,7 @@ int64_t MapStore::RemoveSession(int64_t session_id) {
         files.push_back(detail::FusedFileName(v->key, last.at(v->key) + 1));
     }
     try {
-        detail::ParallelFor(touched.size(), [&](size_t i) {
+        core::ParallelFor(touched.size(), [&](size_t i) {
             const TileVersion& current = *touched[i];
             core::VoxelMap tile = ReadFused(current);
             SessionLayer removed;

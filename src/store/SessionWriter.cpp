@@ -13,10 +13,10 @@
 #include "Catalog.hpp"
 #include "IntegrationRule.hpp"
 #include "MapStoreImpl.hpp"
-#include "Parallel.hpp"
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/ParallelFor.hpp"
 #include "strata/core/OccupancyMasks.hpp"
 #include "strata/integration/UpdateParts.hpp"
 
@@ -114,7 +114,7 @@ struct SessionWriter::State {
             written_files.insert(detail::LayerFileName(key, session_id));
         }
         std::vector<std::pair<TileVersion, LayerFile>> files(keys.size());
-        detail::ParallelFor(keys.size(), [&](size_t i) {
+        core::ParallelFor(keys.size(), [&](size_t i) {
             files[i] = WriteTile(keys[i], fused.at(keys[i]), *logodds.at(keys[i]));
         });
         for (const auto& [v, l] : files) Written(v, l);
@@ -173,7 +173,7 @@ struct SessionWriter::State {
             if (!resident.count(key)) missing.push_back(key);
         }
         std::vector<Loaded> loaded(missing.size());
-        detail::ParallelFor(missing.size(), [&](size_t i) { loaded[i] = Read(missing[i]); });
+        core::ParallelFor(missing.size(), [&](size_t i) { loaded[i] = Read(missing[i]); });
         for (Loaded& l : loaded) {
             resident[l.key];
             if (!l.fused) continue;

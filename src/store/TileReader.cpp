@@ -8,8 +8,8 @@
 #include <unordered_map>
 
 #include "MapStoreImpl.hpp"
-#include "Parallel.hpp"
 #include "TileSplit.hpp"
+#include "strata/core/ParallelFor.hpp"
 
 namespace strata::store {
 
@@ -152,7 +152,7 @@ openvdb::GridPtrVec TileReader::Products(const TileKey& key, const std::string& 
 
 core::VoxelMap TileReader::LoadFused(const std::vector<TileKey>& keys) const {
     std::vector<core::VoxelMap> tiles(keys.size());
-    detail::ParallelFor(keys.size(), [&](size_t i) {
+    core::ParallelFor(keys.size(), [&](size_t i) {
         if (const auto tile = Fused(keys[i])) tiles[i] = tile->DeepCopy();
     });
     core::VoxelMap map = store_->EmptyMap();

@@ -1,5 +1,5 @@
 #pragma once
-// Private to the store: a parallel loop whose failures do not cancel the other iterations.
+// A parallel loop whose failures do not cancel the other iterations.
 // A throw inside tbb::parallel_for cancels the task group, and with it the parallel work OpenVDB
 // runs inside the other iterations (topology unions, leaf loops), which OpenVDB does not expect:
 // a tree left half-built crashed when it was destroyed. Here every iteration runs to its end
@@ -10,8 +10,10 @@
 #include <exception>
 #include <mutex>
 
-namespace strata::store::detail {
+namespace strata::core {
 
+/// @brief Calls body(i) for i in [0, n) in parallel (TBB); every call runs to its end, then the
+/// first exception thrown, if any, is rethrown.
 template <typename Body>
 void ParallelFor(size_t n, const Body& body) {
     std::exception_ptr first;
@@ -27,4 +29,4 @@ void ParallelFor(size_t n, const Body& body) {
     if (first) std::rethrow_exception(first);
 }
 
-}  // namespace strata::store::detail
+}  // namespace strata::core
