@@ -49,35 +49,53 @@ std::string Header(const core::VoxelMap& map, uint64_t count, bool use_double) {
 }  // namespace
 
 void WritePly(const core::VoxelMap& map, const std::filesystem::path& path) {
-    detail::RequireGrids(map, path);
+    WritePly(map, [&](const std::function<void(const core::VoxelMap&)>& visit) { visit(map); },
+             path);
+}
+
+void WritePly(const core::VoxelMap& frame, const MapParts& parts,
+              const std::filesystem::path& path) {
+    detail::RequireGrids(frame, path);
     uint64_t count = 0;
-    detail::ForEachOccupiedVoxel(*map.occupancy, [&](const openvdb::Coord&, float) { ++count; });
-    const bool use_double = !map.origin.isZero();
-    openvdb::Int32Grid::ConstAccessor labels = map.label->getConstAccessor();
+    parts([&](const core::VoxelMap& part) {
+        detail::RequireGrids(part, path);
+        detail::ForEachOccupiedVoxel(*part.occupancy,
+                                     [&](const openvdb::Coord&, float) { ++count; });
+    });
+    const bool use_double = !frame.origin.isZero();
 
     WriteFileAtomically(path, [&](std::ostream& os) {
-        os << Header(map, count, use_double);
+        os << Header(frame, count, use_double);
         std::vector<char> buffer;
         buffer.reserve(kFlushBytes + 64);
-        detail::ForEachOccupiedVoxel(*map.occupancy, [&](const openvdb::Coord& ijk, float) {
-            const Eigen::Vector3d p = map.VoxelCenter(ijk) + map.origin;
-            for (int axis = 0; axis < 3; ++axis) {
-                if (use_double) {
-                    AppendLittleEndian<double, uint64_t>(buffer, p[axis]);
-                } else {
-                    AppendLittleEndian<float, uint32_t>(buffer, static_cast<float>(p[axis]));
+        uint64_t written = 0;
+        parts([&](const core::VoxelMap& part) {
+            openvdb::Int32Grid::ConstAccessor labels = part.label->getConstAccessor();
+            detail::ForEachOccupiedVoxel(*part.occupancy, [&](const openvdb::Coord& ijk, float) {
+                const Eigen::Vector3d p = frame.VoxelCenter(ijk) + frame.origin;
+                for (int axis = 0; axis < 3; ++axis) {
+                    if (use_double) {
+                        AppendLittleEndian<double, uint64_t>(buffer, p[axis]);
+                    } else {
+                        AppendLittleEndian<float, uint32_t>(buffer, static_cast<float>(p[axis]));
+                    }
                 }
-            }
-            const core::SemanticClass c = detail::ClassOf(labels.getValue(ijk));
-            const core::Rgb rgb = core::ClassColor(c);
-            for (uint8_t byte : {rgb.r, rgb.g, rgb.b, static_cast<uint8_t>(c)}) {
-                buffer.push_back(static_cast<char>(byte));
-            }
-            if (buffer.size() >= kFlushBytes) {
-                os.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-                buffer.clear();
-            }
+                const core::SemanticClass c = detail::ClassOf(labels.getValue(ijk));
+                const core::Rgb rgb = core::ClassColor(c);
+                for (uint8_t byte : {rgb.r, rgb.g, rgb.b, static_cast<uint8_t>(c)}) {
+                    buffer.push_back(static_cast<char>(byte));
+                }
+                ++written;
+                if (buffer.size() >= kFlushBytes) {
+                    os.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+                    buffer.clear();
+                }
+            });
         });
+        if (written != count) {
+            throw InvalidArgumentError("cannot export to '" + path.string() +
+                                       "': the map's parts changed between the two passes");
+        }
         os.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     });
 }

@@ -1,10 +1,17 @@
 #include "strata/pipeline/Export.hpp"
 
 #include "strata/core/Error.hpp"
+#include "strata/io/AtomicFile.hpp"
 #include "strata/io/OctomapExport.hpp"
 #include "strata/io/PlyExport.hpp"
 #include "strata/io/PngExport.hpp"
 #include "strata/io/VdbExport.hpp"
+#include "strata/store/TileReader.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <ostream>
 
 namespace strata::pipeline {
 
@@ -58,6 +65,81 @@ std::string ExportMap(const core::VoxelMap& map, const std::filesystem::path& ou
         io::WriteTopDownPng(map, out, png);
     }
     return format;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// `dir/city.vdb` -> `dir/city.X_Y.vdb`.
+fs::path TileFile(const fs::path& out, const store::TileKey& key) {
+    return out.parent_path() / (out.stem().string() + "." + std::to_string(key.x) + "_" +
+                                std::to_string(key.y) + out.extension().string());
+}
+
+ExportResult ExportSplit(const store::MapStore& map, const store::TileReader& reader,
+                         const fs::path& out, const ExportOptions& options,
+                         const std::string& format) {
+    ExportResult result{format, {}, 0};
+    nlohmann::json index = {{"format", format},
+                            {"voxel_size_m", map.settings().voxel_size_m},
+                            {"tile_size_m", map.settings().tile_size_m()},
+                            {"origin", {map.settings().origin.x(), map.settings().origin.y(),
+                                        map.settings().origin.z()}},
+                            {"tiles", nlohmann::json::array()}};
+    ExportOptions one = options;
+    one.format = format;
+    for (const store::TileKey& key : reader.Tiles()) {
+        const auto tile = reader.Fused(key);
+        if (!tile) continue;
+        ++result.tiles_read;
+        const fs::path file = TileFile(out, key);
+        (void)ExportMap(*tile, file, one);
+        result.files.push_back(file);
+        const double t = map.settings().tile_size_m();
+        index["tiles"].push_back({{"x", key.x},
+                                  {"y", key.y},
+                                  {"file", file.filename().string()},
+                                  {"bounds_m", {key.x * t, key.y * t, (key.x + 1) * t, (key.y + 1) * t}}});
+    }
+    const fs::path index_file = out.parent_path() / (out.stem().string() + ".tiles.json");
+    io::WriteFileAtomically(index_file, [&](std::ostream& os) { os << index.dump(2) << "\n"; });
+    result.files.push_back(index_file);
+    return result;
+}
+
+}  // namespace
+
+ExportResult ExportStored(const store::MapStore& map, const store::Snapshot& snapshot,
+                          const fs::path& out, const ExportOptions& options) {
+    const std::string format = ExportFormat(out, options);
+    // Nothing cached: each tile is read, written out and dropped.
+    const store::TileReader reader(map, snapshot, 0);
+    if (options.split) return ExportSplit(map, reader, out, options, format);
+    if (format == "ply") {
+        ExportResult result{format, {out}, 0};
+        const std::vector<store::TileKey> keys = reader.Tiles();
+        io::WritePly(
+            map.EmptyMap(),
+            [&](const std::function<void(const core::VoxelMap&)>& visit) {
+                for (const store::TileKey& key : keys) {
+                    if (const auto tile = reader.Fused(key)) visit(*tile);
+                }
+            },
+            out);
+        result.tiles_read = 2 * keys.size();
+        return result;
+    }
+    const uint64_t bytes = map.Bytes(snapshot).fused_current;
+    if (options.memory_budget_bytes > 0 && bytes > options.memory_budget_bytes) {
+        throw RefusedError(map.dir().string() + ": its fused grids (" +
+                           std::to_string(bytes / 1000000) + " MB on disk) exceed the memory "
+                           "budget (" + std::to_string(options.memory_budget_bytes / 1000000) +
+                           " MB) for one " + format + " file; export one file per tile with "
+                           "--split, or raise --memory-budget");
+    }
+    (void)ExportMap(map.LoadMap(snapshot), out, options);
+    return {format, {out}, snapshot.tiles.size()};
 }
 
 }  // namespace strata::pipeline

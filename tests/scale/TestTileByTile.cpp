@@ -5,7 +5,15 @@
 
 #include "StoreTestUtil.hpp"
 #include "strata/core/Labels.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/Info.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <openvdb/io/File.h>
+#include <sstream>
 
 namespace strata::pipeline {
 namespace {
@@ -46,6 +54,91 @@ TEST(TileByTile, InfoCountsEqualTheWholeMapsCounts) {
     const nlohmann::json first = DescribeMap(map, "1");
     EXPECT_LT(first["occupied_voxels"].get<size_t>(), occupied);
     EXPECT_EQ(first["commit"].get<int64_t>(), map.AsOf(1).commit);
+}
+
+// A PLY file's header and its vertex records sorted (tile order and tree order differ; the set
+// of vertices is what must be equal).
+std::pair<std::string, std::vector<std::string>> PlyVertices(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream all;
+    all << in.rdbuf();
+    const std::string bytes = all.str();
+    const size_t end = bytes.find("end_header\n") + 11;
+    const size_t record = 3 * sizeof(float) + 4;  // x y z, red green blue, label
+    std::vector<std::string> vertices;
+    for (size_t at = end; at + record <= bytes.size(); at += record) {
+        vertices.push_back(bytes.substr(at, record));
+    }
+    EXPECT_EQ((bytes.size() - end) % record, 0u);
+    std::sort(vertices.begin(), vertices.end());
+    return {bytes.substr(0, end), vertices};
+}
+
+store::MapStore TwoRooms(const std::string& name) {
+    store::MapStore map = store::test::NewMap(store::test::Temp(name));
+    (void)store::test::Write(map, store::test::Session(1, {0.4, 0.2, 0.0}, 3));
+    (void)store::test::Write(map, store::test::Session(9, {3.1, -1.7, 0.3}, 2));
+    return map;
+}
+
+TEST(TileByTile, PlyStreamsTheWholeMapsVertices) {
+    const store::MapStore map = TwoRooms("tiles_ply");
+    const fs::path streamed = store::test::Temp("tiles_streamed.ply");
+    const fs::path whole = store::test::Temp("tiles_whole.ply");
+    const ExportResult result = ExportStored(map, map.Latest(), streamed);
+    EXPECT_EQ(result.tiles_read, 2 * map.Latest().tiles.size());
+    (void)ExportMap(map.LoadMap(map.Latest()), whole);
+    const auto [header_s, vertices_s] = PlyVertices(streamed);
+    const auto [header_w, vertices_w] = PlyVertices(whole);
+    EXPECT_EQ(header_s, header_w);  // the same count, properties and comments
+    EXPECT_GT(vertices_w.size(), 1000u);
+    EXPECT_TRUE(vertices_s == vertices_w);
+}
+
+TEST(TileByTile, SplitVdbWritesEveryTileAndAnIndex) {
+    const store::MapStore map = TwoRooms("tiles_split");
+    const fs::path out = store::test::Temp("tiles_split_out") / "city.vdb";
+    fs::create_directories(out.parent_path());
+    ExportOptions options;
+    options.split = true;
+    const ExportResult result = ExportStored(map, map.Latest(), out, options);
+    const size_t tiles = map.Latest().tiles.size();
+    ASSERT_EQ(result.files.size(), tiles + 1);
+    std::ifstream in(out.parent_path() / "city.tiles.json");
+    const nlohmann::json index = nlohmann::json::parse(in);
+    ASSERT_EQ(index["tiles"].size(), tiles);
+    EXPECT_EQ(index["format"], "vdb");
+    // Every tile file holds its tile's occupancy; together they are the map's.
+    size_t voxels = 0;
+    for (const auto& t : index["tiles"]) {
+        openvdb::io::File file((out.parent_path() / t["file"].get<std::string>()).string());
+        file.open();
+        const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("occupancy"));
+        voxels += grid->activeVoxelCount();
+        const double t0 = t["bounds_m"][0].get<double>(), t1 = t["bounds_m"][2].get<double>();
+        const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+        EXPECT_GE(box.min().x() * map.settings().voxel_size_m, t0 - 1e-9);
+        EXPECT_LE((box.max().x() + 1) * map.settings().voxel_size_m, t1 + 1e-9);
+    }
+    EXPECT_EQ(voxels, map.LoadMap(map.Latest()).occupancy->activeVoxelCount());
+}
+
+TEST(TileByTile, AWholeMapExportOverTheBudgetIsRefusedBeforeAnythingIsWritten) {
+    const store::MapStore map = TwoRooms("tiles_budget");
+    const fs::path out = store::test::Temp("tiles_budget.vdb");
+    ExportOptions options;
+    options.memory_budget_bytes = 1000;
+    try {
+        (void)ExportStored(map, map.Latest(), out, options);
+        ADD_FAILURE() << "not refused";
+    } catch (const RefusedError& e) {
+        EXPECT_NE(std::string(e.what()).find("--split"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(out));
+    options.format = "ply";  // PLY streams whatever the budget
+    const fs::path ply = store::test::Temp("tiles_budget.ply");
+    (void)ExportStored(map, map.Latest(), ply, options);
+    EXPECT_GT(fs::file_size(ply), 1000u);
 }
 
 }  // namespace

@@ -19,6 +19,8 @@ struct ExportArgs {
     int pixels_per_voxel = 2;
     std::string color = "auto";
     std::string as_of;
+    double memory_budget_mb = 512.0;
+    bool split = false;
 };
 
 void Run(const ExportArgs& args) {
@@ -26,11 +28,21 @@ void Run(const ExportArgs& args) {
     options.format = args.format;
     options.pixels_per_voxel = args.pixels_per_voxel;
     options.color = args.color;
+    options.memory_budget_bytes = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    options.split = args.split;
     (void)pipeline::ExportFormat(args.out, options);  // a bad name fails before the map is read
     const store::MapStore store = OpenMap(args.map);
-    pipeline::ExportMap(store.LoadMap(SelectSnapshot(store, args.as_of)), args.out, options);
-    std::cout << "wrote " << args.out << " (" << std::filesystem::file_size(args.out)
-              << " bytes)\n";
+    const pipeline::ExportResult result =
+        pipeline::ExportStored(store, SelectSnapshot(store, args.as_of), args.out, options);
+    if (!args.split) {
+        std::cout << "wrote " << args.out << " (" << std::filesystem::file_size(args.out)
+                  << " bytes)\n";
+        return;
+    }
+    uint64_t bytes = 0;
+    for (const auto& f : result.files) bytes += std::filesystem::file_size(f);
+    std::cout << "wrote " << result.files.size() - 1 << " tile files and the index "
+              << result.files.back().string() << " (" << bytes << " bytes)\n";
 }
 
 }  // namespace
@@ -43,7 +55,8 @@ void RegisterExport(CLI::App& app) {
         "Examples:\n"
         "  strata export city.strata --out city.vdb          # vdb_print, vdb_view, Blender\n"
         "  strata export city.strata --format ot --out city.ot  # octovis, ROS (class colours)\n"
-        "  strata export city.strata --out city.png           # top-down picture");
+        "  strata export city.strata --out city.png           # top-down picture\n"
+        "  strata export city.strata --out city.vdb --split  # one file per tile + index");
     cmd->add_option("MAP", args->map, "Map directory")->required();
     cmd->add_option("--format", args->format, "vdb, bt, ot, ply or png (default: from --out)")
         ->check(CLI::IsMember({"vdb", "bt", "ot", "ply", "png"}));
@@ -56,6 +69,13 @@ void RegisterExport(CLI::App& app) {
         ->check(CLI::IsMember({"auto", "class", "height"}))
         ->capture_default_str();
     cmd->add_option("--as-of", args->as_of, "Export the map as it was right after this session");
+    cmd->add_option("--memory-budget", args->memory_budget_mb,
+                    "MB: a larger map is refused for one vdb/bt/ot/png file (use --split); PLY "
+                    "streams tile by tile")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    cmd->add_flag("--split", args->split,
+                  "One file per tile (NAME.X_Y.EXT) and an index NAME.tiles.json");
     cmd->callback([args] { Run(*args); });
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 
 #include "strata/core/VoxelMap.hpp"
 
@@ -16,5 +17,15 @@ namespace strata::io {
 /// (temporary file + rename). Two sequential passes over the active voxels (count, then write);
 /// memory use is a fixed-size buffer.
 void WritePly(const core::VoxelMap& map, const std::filesystem::path& path);
+
+/// @brief Visits the parts of a map (its tiles) one by one: calls `visit` once per part, in the
+/// same order every time it is called.
+using MapParts = std::function<void(const std::function<void(const core::VoxelMap&)>& visit)>;
+
+/// @brief WritePly of a map given in parts, so that only one part need be in memory: `parts` is
+/// called twice (count, then write); `frame` gives the voxel size and origin every part shares.
+/// The vertices are the same as WritePly's of the whole map, part after part.
+void WritePly(const core::VoxelMap& frame, const MapParts& parts,
+              const std::filesystem::path& path);
 
 }  // namespace strata::io

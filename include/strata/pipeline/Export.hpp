@@ -3,8 +3,10 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "strata/core/VoxelMap.hpp"
+#include "strata/store/MapStore.hpp"
 
 namespace strata::pipeline {
 
@@ -15,6 +17,11 @@ struct ExportOptions {
     int pixels_per_voxel = 2;  ///< PNG scale
     /// PNG colours: "class", "height", or "auto" (height when the map has no labels).
     std::string color = "auto";
+    /// A stored map whose fused files are larger than this is refused for the formats written
+    /// from the whole map (vdb, bt, ot, png) unless `split`; 0: no limit. PLY always streams.
+    size_t memory_budget_bytes = size_t{512} << 20;
+    /// One file per tile beside `out` (`NAME.X_Y.EXT`) and an index `NAME.tiles.json`.
+    bool split = false;
 
     /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;
@@ -30,5 +37,21 @@ struct ExportOptions {
 /// format written. The file is checked before anything is written (ExportFormat).
 std::string ExportMap(const core::VoxelMap& map, const std::filesystem::path& out,
                       const ExportOptions& options = {});
+
+/// @brief What ExportStored wrote.
+struct ExportResult {
+    std::string format;
+    std::vector<std::filesystem::path> files;  ///< `out`, or the tiles' files and the index
+    size_t tiles_read = 0;
+};
+
+/// @brief Writes the snapshot of a stored map, tile by tile where the format allows: PLY streams
+/// tile after tile (two passes, one tile in memory); with `split` every format writes one file
+/// per tile and an index listing each file with its tile's bounds (map frame, metres); otherwise
+/// vdb, bt, ot and png load the snapshot whole.
+/// @throw RefusedError, before anything is written, when a whole-map export would exceed
+/// `memory_budget_bytes` (the message names --split); ExportFormat's errors; IoError.
+ExportResult ExportStored(const store::MapStore& map, const store::Snapshot& snapshot,
+                          const std::filesystem::path& out, const ExportOptions& options = {});
 
 }  // namespace strata::pipeline
