@@ -1,142 +1,9 @@
 #include "strata/change/ChangeDetection.hpp"
+
+#include "ChangeSteps.hpp"
 #include "strata/core/Error.hpp"
 
-#include <openvdb/tools/Morphology.h>
-#include <openvdb/tools/Prune.h>
-
-#include <algorithm>
-#include <stdexcept>
-#include <tuple>
-#include <vector>
-
 namespace strata::change {
-namespace {
-
-using openvdb::BoolGrid;
-
-BoolGrid::Ptr Copy(const BoolGrid& grid) { return grid.deepCopy(); }
-
-// The masks of one side restricted to the query's region (shared, not copied, without one).
-core::OccupancyMasks InRegion(const core::OccupancyMasks& masks, const ChangeQuery& query,
-                              double voxel_size) {
-    if (!query.region) return masks;
-    core::OccupancyMasks out{Copy(*masks.occupied), Copy(*masks.free)};
-    query.region->Clip(*out.occupied, voxel_size);
-    query.region->Clip(*out.free, voxel_size);
-    return out;
-}
-
-// Candidates: occupied(X) AND free(Y).
-BoolGrid::Ptr SeenOccupiedAndFree(const BoolGrid& occupied, const core::OccupancyMasks& other) {
-    BoolGrid::Ptr out = Copy(occupied);
-    out->topologyIntersection(*other.free);
-    return out;
-}
-
-// The candidates that are changes beyond doubt: minus those within the surface tolerance of
-// occupied(Y) and those with a voxel Y never observed within the margin along an axis. Both checks
-// look around the (few) candidates only, instead of dilating Y's surfaces or eroding what Y
-// observed.
-BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& other,
-                        const ChangeQuery& query) {
-    BoolGrid::Ptr out = Copy(candidates);
-    const int t = std::max(0, query.surface_tolerance_voxels);
-    const int m = std::max(0, query.observed_margin_voxels);
-    if (t == 0 && m == 0 && query.support_depth_voxels <= 0) return out;
-    auto surface = other.occupied->getConstAccessor();
-    auto free = other.free->getConstAccessor();
-    const auto near_surface = [&](const openvdb::Coord& c) {
-        for (int dx = -t; dx <= t; ++dx) {
-            for (int dy = -t; dy <= t; ++dy) {
-                for (int dz = -t; dz <= t; ++dz) {
-                    if (surface.isValueOn(c.offsetBy(dx, dy, dz))) return true;
-                }
-            }
-        }
-        return false;
-    };
-    const auto on_rim = [&](const openvdb::Coord& c) {
-        for (int axis = 0; axis < 3; ++axis) {
-            for (int step = 1; step <= m; ++step) {
-                for (int sign : {-1, 1}) {
-                    openvdb::Coord n = c;
-                    n[axis] += sign * step;
-                    if (!free.isValueOn(n) && !surface.isValueOn(n)) return true;
-                }
-            }
-        }
-        return false;
-    };
-    // Down the column: did the other side observe everything below, down to a surface it saw
-    // or to the depth? (A floor seen only by grazing rays has unknown ground right under it.)
-    const int depth = std::max(0, query.support_depth_voxels);
-    const auto unsupported = [&](openvdb::Coord c) {
-        for (int k = 0; k < depth; ++k) {
-            c.z() -= 1;
-            if (surface.isValueOn(c)) return false;
-            if (!free.isValueOn(c)) return true;
-        }
-        return false;
-    };
-    std::vector<openvdb::Coord> drop;
-    for (auto on = out->cbeginValueOn(); on; ++on) {
-        const openvdb::Coord c = on.getCoord();
-        if ((t > 0 && near_surface(c)) || (m > 0 && on_rim(c)) || (depth > 0 && unsupported(c))) {
-            drop.push_back(c);
-        }
-    }
-    auto acc = out->getAccessor();
-    for (const openvdb::Coord& c : drop) acc.setValueOff(c, false);
-    openvdb::tools::pruneInactive(out->tree());
-    return out;
-}
-
-// Hysteresis: the confident changes grown back into the candidates within `steps` voxels, so an
-// object keeps the voxels the safeguards trimmed at its edges (a car's lowest layer above the
-// road) while candidates with no confident change near them stay out.
-BoolGrid::Ptr GrowInto(const BoolGrid& confident, const BoolGrid& candidates, int steps) {
-    BoolGrid::Ptr out = Copy(confident);
-    if (steps <= 0 || out->empty()) return out;
-    openvdb::tools::dilateActiveValues(out->tree(), steps, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
-    out->topologyIntersection(candidates);
-    return out;
-}
-
-// The changes of one kind: occupied on one side, free on the other. Only confident groups of at
-// least the minimum size grow, so a speck that passed the safeguards cannot grow into an object.
-BoolGrid::Ptr Changes(const BoolGrid& occupied, const core::OccupancyMasks& other,
-                      const ChangeQuery& query, double voxel_size) {
-    const BoolGrid::Ptr candidates = SeenOccupiedAndFree(occupied, other);
-    const BoolGrid::Ptr confident = Confident(*candidates, other, query);
-    if (query.grow_voxels <= 0) return confident;
-    BoolGrid::Ptr cores = confident->copyWithNewTree();
-    auto acc = cores->getAccessor();
-    for (const ObjectVoxels& group :
-         GroupObjects(*confident, ChangeKind::kAdded, voxel_size, query.gap_voxels, nullptr)) {
-        if (group.voxels.size() < query.min_voxels) continue;
-        for (const openvdb::Coord& c : group.voxels) acc.setValueOn(c, true);
-    }
-    return GrowInto(*cores, *candidates, query.grow_voxels);
-}
-
-// Voxels `a` observed (occupied or free) that `b` did not.
-size_t ObservedOnlyBy(const core::OccupancyMasks& a, const core::OccupancyMasks& b) {
-    BoolGrid::Ptr only = Copy(*a.occupied);
-    only->topologyUnion(*a.free);
-    only->topologyDifference(*b.occupied);
-    only->topologyDifference(*b.free);
-    return only->activeVoxelCount();
-}
-
-void Require(const Observation& o, const char* side) {
-    if (!o.masks.occupied || !o.masks.free) {
-        throw InvalidArgumentError(std::string("change detection: side ") + side +
-                                    " has no occupied/free masks");
-    }
-}
-
-}  // namespace
 
 const char* ChangeKindName(ChangeKind kind) {
     return kind == ChangeKind::kAdded ? "added" : "removed";
@@ -144,44 +11,30 @@ const char* ChangeKindName(ChangeKind kind) {
 
 ChangeSet DetectChanges(const Observation& a, const Observation& b, double voxel_size,
                         const ChangeQuery& query) {
-    Require(a, "A");
-    Require(b, "B");
+    detail::Require(a, "A");
+    detail::Require(b, "B");
     if (!(voxel_size > 0.0)) throw InvalidArgumentError("change detection: voxel size <= 0");
 
-    const core::OccupancyMasks ra = InRegion(a.masks, query, voxel_size);
-    const core::OccupancyMasks rb = InRegion(b.masks, query, voxel_size);
+    const core::OccupancyMasks ra = detail::InRegion(a.masks, query, voxel_size);
+    const core::OccupancyMasks rb = detail::InRegion(b.masks, query, voxel_size);
 
     ChangeSet result;
     result.voxel_size = voxel_size;
-    result.unknown_voxels = ObservedOnlyBy(ra, rb) + ObservedOnlyBy(rb, ra);
-    const BoolGrid::Ptr added = Changes(*rb.occupied, ra, query, voxel_size);
-    const BoolGrid::Ptr removed = Changes(*ra.occupied, rb, query, voxel_size);
-    result.added_voxels_total = added->activeVoxelCount();
-    result.removed_voxels_total = removed->activeVoxelCount();
-
-    result.added = added->copyWithNewTree();
-    result.removed = removed->copyWithNewTree();
-    std::vector<ObjectVoxels> kept;
-    for (const auto& [mask, kind, labels] :
-         {std::tuple{added.get(), ChangeKind::kAdded, b.labels.get()},
-          std::tuple{removed.get(), ChangeKind::kRemoved, a.labels.get()}}) {
-        for (ObjectVoxels& group :
-             GroupObjects(*mask, kind, voxel_size, query.gap_voxels, labels)) {
-            if (group.object.voxels < query.min_voxels) continue;
-            if (query.class_filter && group.object.dominant_class != *query.class_filter) continue;
-            kept.push_back(std::move(group));
-        }
-    }
-    std::stable_sort(kept.begin(), kept.end(), [](const auto& x, const auto& y) {
-        return x.object.voxels > y.object.voxels;
-    });
-    for (ObjectVoxels& group : kept) {
-        group.object.id = static_cast<int>(result.objects.size()) + 1;
-        BoolGrid& out = group.object.kind == ChangeKind::kAdded ? *result.added : *result.removed;
-        auto acc = out.getAccessor();
-        for (const openvdb::Coord& c : group.voxels) acc.setValueOn(c, true);
-        result.objects.push_back(group.object);
-    }
+    result.unknown_voxels = detail::ObservedOnlyBy(ra, rb) + detail::ObservedOnlyBy(rb, ra);
+    // The changes of one kind: occupied on one side, free on the other. Only confident groups of
+    // at least the minimum size grow, so a speck that passed the safeguards cannot grow into an
+    // object.
+    const auto changes = [&](const openvdb::BoolGrid& occupied, const core::OccupancyMasks& other) {
+        const openvdb::BoolGrid::Ptr candidates = detail::SeenOccupiedAndFree(occupied, other);
+        const openvdb::BoolGrid::Ptr confident = detail::Confident(*candidates, other, query);
+        if (query.grow_voxels <= 0) return confident;
+        return detail::GrowInto(*detail::Cores(*confident, query, voxel_size), *candidates,
+                                query.grow_voxels);
+    };
+    const openvdb::BoolGrid::Ptr added = changes(*rb.occupied, ra);
+    const openvdb::BoolGrid::Ptr removed = changes(*ra.occupied, rb);
+    detail::CollectObjects(*added, *removed, a.labels.get(), b.labels.get(), query, voxel_size,
+                           result);
     return result;
 }
 

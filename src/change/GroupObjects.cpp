@@ -91,13 +91,17 @@ std::vector<ObjectVoxels> GroupObjects(const openvdb::BoolGrid& mask, ChangeKind
     }
     std::vector<ObjectVoxels> objects;
     for (std::vector<Coord>& voxels : geometry::GroupVoxels(coords, std::max(0, gap_voxels) + 1)) {
+        // In x, y, z order: the sums of the statistics, and so their last bits, do not depend on
+        // the order the mask was read in (one map, or tile by tile).
+        std::sort(voxels.begin(), voxels.end());
         ObjectVoxels group;
         group.object = Describe(voxels, kind, voxel_size, labels);
         group.voxels = std::move(voxels);
         objects.push_back(std::move(group));
     }
-    std::stable_sort(objects.begin(), objects.end(), [](const auto& a, const auto& b) {
-        return a.object.voxels > b.object.voxels;
+    std::sort(objects.begin(), objects.end(), [](const auto& a, const auto& b) {
+        if (a.object.voxels != b.object.voxels) return a.object.voxels > b.object.voxels;
+        return a.voxels.front() < b.voxels.front();
     });
     return objects;
 }

@@ -5,6 +5,7 @@
 
 #include "StoreTestUtil.hpp"
 #include "strata/core/Labels.hpp"
+#include "strata/change/MapObserver.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/Info.hpp"
@@ -139,6 +140,59 @@ TEST(TileByTile, AWholeMapExportOverTheBudgetIsRefusedBeforeAnythingIsWritten) {
     const fs::path ply = store::test::Temp("tiles_budget.ply");
     (void)ExportStored(map, map.Latest(), ply, options);
     EXPECT_GT(fs::file_size(ply), 1000u);
+}
+
+void ExpectSameChanges(const change::ChangeSet& tiled, const change::ChangeSet& whole) {
+    EXPECT_EQ(tiled.unknown_voxels, whole.unknown_voxels);
+    EXPECT_EQ(tiled.added_voxels_total, whole.added_voxels_total);
+    EXPECT_EQ(tiled.removed_voxels_total, whole.removed_voxels_total);
+    EXPECT_TRUE(tiled.added->tree().hasSameTopology(whole.added->tree()));
+    EXPECT_TRUE(tiled.removed->tree().hasSameTopology(whole.removed->tree()));
+    ASSERT_EQ(tiled.objects.size(), whole.objects.size());
+    for (size_t i = 0; i < whole.objects.size(); ++i) {
+        const change::ChangeObject &t = tiled.objects[i], &w = whole.objects[i];
+        EXPECT_EQ(t.id, w.id);
+        EXPECT_EQ(t.kind, w.kind);
+        EXPECT_EQ(t.voxels, w.voxels);
+        EXPECT_EQ(t.bbox_min, w.bbox_min);
+        EXPECT_EQ(t.bbox_max, w.bbox_max);
+        EXPECT_EQ(t.centroid, w.centroid);  // bit for bit: voxels summed in one order
+        EXPECT_EQ(t.oriented.yaw_deg, w.oriented.yaw_deg);
+        EXPECT_EQ(t.dominant_class, w.dominant_class);
+    }
+}
+
+TEST(TileByTile, ChangesReadTileByTileAreTheWholeMapsChanges) {
+    const store::MapStore map = TwoRooms("tiles_diff");
+    change::MapObserver observer(map);
+    // Two rooms 2.7 m apart in x, in 3.2 m tiles: each one's walls stand in the other's free
+    // space, so changes cross many tile borders.
+    change::ChangeQuery query;
+    const change::ChangeSet whole =
+        change::DetectChanges(observer.Session(1), observer.Session(2), 0.1, query);
+    ASSERT_GE(whole.objects.size(), 3u);
+    size_t tiles_crossed = 0;
+    for (const change::ChangeObject& o : whole.objects) {
+        tiles_crossed += std::floor(o.bbox_min.x() / 3.2) != std::floor((o.bbox_max.x() - 1e-6) / 3.2);
+    }
+    EXPECT_GT(tiles_crossed, 0u);
+    ExpectSameChanges(change::DetectChangesByTiles(observer.SessionSide(1),
+                                                   observer.SessionSide(2), map.settings(), query),
+                      whole);
+    // Without growth, in a region, and between snapshots of the fused map.
+    query.grow_voxels = 0;
+    query.region = core::Region::Box(-1.0, -4.0, 6.0, 3.0);
+    change::MapObserver in_region(map, query.region);
+    ExpectSameChanges(
+        change::DetectChangesByTiles(in_region.SessionSide(1), in_region.SessionSide(2),
+                                     map.settings(), query),
+        change::DetectChanges(in_region.Session(1), in_region.Session(2), 0.1, query));
+    change::ChangeQuery maps;
+    ExpectSameChanges(change::DetectChangesByTiles(observer.MapSide(map.AsOf(1)),
+                                                   observer.MapSide(map.Latest()), map.settings(),
+                                                   maps),
+                      change::DetectChanges(observer.Map(map.AsOf(1)), observer.Map(map.Latest()),
+                                            0.1, maps));
 }
 
 }  // namespace

@@ -113,8 +113,8 @@ struct ObjectVoxels {
 };
 
 /// @brief Groups the active voxels of `mask` into objects (voxels at most `gap_voxels` + 1 apart
-/// in every axis join), with their statistics, largest first (ids not yet assigned). `labels` may
-/// be null.
+/// in every axis join), with their statistics, largest first, equal sizes by their smallest
+/// voxel (ids not yet assigned); each object's voxels in x, y, z order. `labels` may be null.
 [[nodiscard]] std::vector<ObjectVoxels> GroupObjects(const openvdb::BoolGrid& mask, ChangeKind kind,
                                                      double voxel_size, int gap_voxels,
                                                      const openvdb::Int32Grid* labels);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "strata/change/ChangeDetection.hpp"
+#include "strata/change/TiledChanges.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/store/TileReader.hpp"
 
@@ -30,8 +31,16 @@ public:
     /// <= 0; classes from its labels.
     [[nodiscard]] Observation Map(const store::Snapshot& snapshot);
 
+    /// @brief Session() for DetectChangesByTiles: observed tile by tile, on demand. The side
+    /// reads through this observer's cache; it must not outlive the observer.
+    [[nodiscard]] TiledSide SessionSide(int64_t session_id);
+    /// @brief Map() for DetectChangesByTiles.
+    [[nodiscard]] TiledSide MapSide(const store::Snapshot& snapshot);
+
 private:
     [[nodiscard]] std::vector<store::TileKey> Keys(const store::TileReader& reader) const;
+    /// The reader of the snapshot right after session `session_id` (or the oldest kept).
+    [[nodiscard]] store::TileReader SessionReader(int64_t session_id) const;
 
     const store::MapStore& store_;
     std::optional<core::Region> region_;

@@ -1,0 +1,59 @@
+#pragma once
+// Grids cut to an index box, leaf by leaf. Grid::clip fills the part of every node outside the
+// box with the background, which for the boxes tiles use (unbounded in z) builds and prunes
+// nodes across the whole index range: seconds per call. These touch only the leaves there are.
+
+#include <openvdb/openvdb.h>
+
+#include <vector>
+
+namespace strata::core {
+
+/// @brief Adds the active voxels of `from` inside `box` (values and states) to `into`, which
+/// must hold no leaf where `from` has one inside the box (the disjoint pieces of tiles).
+template <typename GridT>
+void CopyInside(const GridT& from, const openvdb::CoordBBox& box, GridT& into) {
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {
+        const openvdb::CoordBBox bounds = leaf->getNodeBoundingBox();
+        if (!box.hasOverlap(bounds)) continue;
+        auto* copy = new LeafT(*leaf);
+        if (!box.isInside(bounds)) {
+            for (auto on = copy->beginValueOn(); on; ++on) {
+                if (!box.isInside(on.getCoord())) on.setValueOff();
+            }
+        }
+        into.tree().addLeaf(copy);
+    }
+    // Active tiles above the leaves (pruned uniform regions): their part inside the box.
+    for (auto it = from.tree().cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue()) continue;
+        openvdb::CoordBBox part = it.getBoundingBox();
+        part.intersect(box);
+        if (!part.empty()) into.tree().fill(part, *it, true);
+    }
+}
+
+/// @brief Deactivates every voxel of `grid` outside `box` and drops the leaves wholly outside.
+template <typename GridT>
+void KeepInside(GridT& grid, const openvdb::CoordBBox& box) {
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    std::vector<openvdb::Coord> outside;
+    for (auto leaf = grid.tree().beginLeaf(); leaf; ++leaf) {
+        const openvdb::CoordBBox bounds = leaf->getNodeBoundingBox();
+        if (!box.hasOverlap(bounds)) {
+            outside.push_back(leaf->origin());
+        } else if (!box.isInside(bounds)) {
+            for (auto on = leaf->beginValueOn(); on; ++on) {
+                if (!box.isInside(on.getCoord())) on.setValueOff();
+            }
+        }
+    }
+    const auto background = grid.background();
+    for (const openvdb::Coord& origin : outside) {
+        delete grid.tree().template stealNode<LeafT>(origin, background, false);
+    }
+    if (grid.tree().activeTileCount() > 0) grid.clip(box);  // rare: uniform regions as tiles
+}
+
+}  // namespace strata::core
