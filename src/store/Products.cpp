@@ -111,14 +111,20 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
     std::vector<TileVersion> versions;
     std::vector<ProductFile> files;
     std::vector<std::string> written;
+    // Each grid cut into its tiles once, leaf by leaf (tile edges fall on leaf edges).
+    std::map<TileKey, openvdb::GridPtrVec> by_tile;
+    for (const auto& g : product.grids) {
+        g->apply<detail::VoxelGridTypes>([&](const auto& typed) {
+            auto copy = typed.deepCopy();
+            copy->tree().voxelizeActiveTiles();
+            for (auto& [key, piece] : detail::StealTiles(*copy, impl.settings, &keys)) {
+                if (!piece->empty()) by_tile[key].push_back(piece);
+            }
+        });
+    }
     try {
         for (const TileKey& key : keys) {
-            openvdb::GridPtrVec pieces;
-            for (const auto& g : product.grids) {
-                openvdb::GridBase::Ptr piece = g->deepCopyGrid();
-                piece->clip(impl.settings.TileBounds(key));
-                if (!piece->empty()) pieces.push_back(piece);
-            }
+            const openvdb::GridPtrVec& pieces = by_tile[key];
             if (!pieces.empty()) {
                 ProductFile p;
                 p.key = key;
