@@ -15,7 +15,7 @@ void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float d
                 float hi) {
     tree.topologyUnion(mask);
     openvdb::tree::LeafManager<const openvdb::MaskTree> leaves(mask);
-    leaves.foreach([&](const openvdb::MaskTree::LeafNodeType& mask_leaf, size_t) {
+    leaves.foreach ([&](const openvdb::MaskTree::LeafNodeType& mask_leaf, size_t) {
         float* values = tree.probeLeaf(mask_leaf.origin())->buffer().data();
         for (auto on = mask_leaf.getValueMask().beginOn(); on; ++on) {
             float& v = values[on.pos()];
@@ -34,7 +34,8 @@ void ApplyOccupancy(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
     AddLogOdds(*update.occupied, occupancy.tree(), core::LogOdds(config.prob_hit), lo, hi);
 }
 
-void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const IntegrationConfig& config) {
+void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map,
+                    const IntegrationConfig& config) {
     // Hits and mean endpoint, packed in one value: activate every endpoint voxel (parallel
     // topologyUnion), then update the values straight in the leaf buffers; groups come sorted, so
     // consecutive groups mostly share a leaf. The mean is a running mean over all scans
