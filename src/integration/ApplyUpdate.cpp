@@ -1,25 +1,51 @@
 #include "ApplyUpdate.hpp"
 
-#include <openvdb/tree/LeafManager.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <vector>
 
 namespace strata::integration::detail {
 namespace {
 
+using MaskLeaf = openvdb::MaskTree::LeafNodeType;
+
+// Activates every voxel of `mask` in `tree` (tree.topologyUnion(mask): newly observed voxels keep
+// the value they hold, the background; active tiles under the mask become leaves) and returns,
+// per mask leaf, the tree's leaf at its origin. Serial, as topology changes must be, but one
+// cached accessor walk per leaf: topologyUnion visits every child slot of every top-level node
+// (32^3 each, eight for a map around its origin), a fixed cost per scan larger than the work
+// (docs/integration.md, "Speed").
+template <typename TreeT>
+std::vector<typename TreeT::LeafNodeType*> ActivateLeaves(const openvdb::MaskTree& mask,
+                                                          TreeT& tree,
+                                                          std::vector<const MaskLeaf*>& masks) {
+    std::vector<typename TreeT::LeafNodeType*> leaves;
+    masks.clear();
+    openvdb::tree::ValueAccessor<TreeT> acc(tree);
+    for (auto it = mask.cbeginLeaf(); it; ++it) {
+        auto* leaf = acc.touchLeaf(it->origin());
+        leaf->getValueMask() |= it->getValueMask();
+        leaves.push_back(leaf);
+        masks.push_back(&*it);
+    }
+    return leaves;
+}
+
 // Adds `delta` to every voxel of `mask` (an unobserved voxel starts at log-odds 0), clamped to
-// [lo, hi]: OctoMap's updateNodeLogOdds. The mask's voxels are first activated in the tree
-// (topologyUnion, parallel; newly observed voxels take the background, 0, and active tiles under
-// the mask become leaves), then values are updated in parallel, one mask leaf per task.
+// [lo, hi]: OctoMap's updateNodeLogOdds. Values are updated in parallel, one mask leaf per task.
 void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float delta, float lo,
                 float hi) {
-    tree.topologyUnion(mask);
-    openvdb::tree::LeafManager<const openvdb::MaskTree> leaves(mask);
-    leaves.foreach ([&](const openvdb::MaskTree::LeafNodeType& mask_leaf, size_t) {
-        float* values = tree.probeLeaf(mask_leaf.origin())->buffer().data();
-        for (auto on = mask_leaf.getValueMask().beginOn(); on; ++on) {
-            float& v = values[on.pos()];
-            v = std::clamp(v + delta, lo, hi);
+    std::vector<const MaskLeaf*> masks;
+    const auto leaves = ActivateLeaves(mask, tree, masks);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& range) {
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            float* values = leaves[i]->buffer().data();
+            for (auto on = masks[i]->getValueMask().beginOn(); on; ++on) {
+                float& v = values[on.pos()];
+                v = std::clamp(v + delta, lo, hi);
+            }
         }
     });
 }
@@ -36,17 +62,18 @@ void ApplyOccupancy(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
 
 void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map,
                     const IntegrationConfig& config) {
-    // Hits and mean endpoint, packed in one value: activate every endpoint voxel (parallel
-    // topologyUnion), then update the values straight in the leaf buffers; groups come sorted, so
-    // consecutive groups mostly share a leaf. The mean is a running mean over all scans
-    // (core/Endpoints.hpp, Accumulate).
+    // Hits and mean endpoint, packed in one value: activate every endpoint voxel, then update the
+    // values straight in the leaf buffers; groups come sorted, so consecutive groups mostly share
+    // a leaf. The mean is a running mean over all scans (core/Endpoints.hpp, Accumulate).
     openvdb::Int32Tree& endpoints = map.endpoints->tree();
-    endpoints.topologyUnion(*update.occupied);
+    std::vector<const MaskLeaf*> masks;
+    (void)ActivateLeaves(*update.occupied, endpoints, masks);
+    openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(endpoints);
     const double s = map.voxel_size;
     openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
     for (const EndpointGroup& g : update.endpoints) {
         const openvdb::Coord origin(g.ijk.x() & ~7, g.ijk.y() & ~7, g.ijk.z() & ~7);
-        if (!leaf || origin != leaf->origin()) leaf = endpoints.probeLeaf(g.ijk);
+        if (!leaf || origin != leaf->origin()) leaf = acc.probeLeaf(g.ijk);
         int32_t& packed = leaf->buffer().data()[leaf->coordToOffset(g.ijk)];
         packed = config.keep_point_means
                      ? core::endpoint::Accumulate(packed, g.points, g.offset_sum, s, g.ijk)
