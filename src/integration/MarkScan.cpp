@@ -96,7 +96,7 @@ ScanMasks MarkDense(const PreparedScan& scan) {
                           const auto mark = [bits](int64_t pos) {
                               bits[pos >> 6] |= uint64_t{1} << (pos & 63);
                           };
-                          TraceRays(scan, range, mark);
+                          TraceRays(scan, range, mark, bits);
                       });
     Bitmap occupied_bits(n_bytes);
     for (const int64_t pos : scan.endpoint_pos) occupied_bits.Set(pos);
@@ -162,8 +162,9 @@ ScanMasks MarkSparse(const PreparedScan& scan) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
                           openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(free_trees.local());
-                          TraceRays(scan, range,
-                                    [&](int64_t pos) { acc.setValueOn(box.CoordOf(pos)); });
+                          TraceRays(
+                              scan, range, [&](int64_t pos) { acc.setValueOn(box.CoordOf(pos)); },
+                              nullptr);
                       });
     ScanMasks masks;
     for (const auto& tree : free_trees) masks.free->topologyUnion(tree);

@@ -40,8 +40,10 @@ VoxelBox MakeBox(openvdb::CoordBBox bbox) {
     bbox.expand(1);  // one voxel of padding: a ray's rounding can never leave the box
     VoxelBox box;
     box.lo = openvdb::Coord(bbox.min().x() & ~7, bbox.min().y() & ~7, bbox.min().z() & ~7);
+    // z, the fastest axis, to a multiple of 64 voxels: a bitmap row is then whole words, and
+    // an x or y step of a walk moves by whole words (TraceRay.hpp, WordCursor).
     const openvdb::Coord hi((bbox.max().x() | 7) + 1, (bbox.max().y() | 7) + 1,
-                            (bbox.max().z() | 7) + 1);
+                            box.lo.z() + ((bbox.max().z() - box.lo.z()) | 63) + 1);
     box.nx = int64_t{hi.x()} - box.lo.x();
     box.ny = int64_t{hi.y()} - box.lo.y();
     box.nz = int64_t{hi.z()} - box.lo.z();

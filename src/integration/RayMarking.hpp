@@ -14,7 +14,8 @@
 namespace strata::integration::detail {
 
 /// The box of voxels a scan can touch, padded by one voxel and aligned to 8 (VDB leaves), so a
-/// brick of the box is exactly one leaf. `pos` values are linear indices into it, z fastest.
+/// brick of the box is exactly one leaf; its z extent is a multiple of 64. `pos` values are linear
+/// indices into it, z fastest.
 struct VoxelBox {
     openvdb::Coord lo;               // first voxel, multiple of 8 in each axis
     int64_t nx = 0, ny = 0, nz = 0;  // extents, multiples of 8
