@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "RayMarking.hpp"
 
@@ -76,9 +77,10 @@ PointKind ClassifyPoint(const Vec3<T>& p, const Vec3<T>& origin, double inv_voxe
 
 // computeRayKeys' initialisation: the direction normalised in T, the voxel border offset rounded
 // to T, tMax and tDelta in double; an axis the direction does not move along never steps. What
-// does not depend on the ray (the origin in T, its box index, the strides) is computed once.
-// The border stays per ray, as OctoMap writes it: hoisted into a loop over the two step signs,
-// GCC 12 at -O3 dropped its rounding to float (tMax then differed from OctoMap's by 1e-8).
+// does not depend on the ray (the origin, its box index, the strides, the origin voxel's centre
+// and half a voxel rounded to T) is computed once, by the same operations. The rounding goes
+// through RoundToFloat: written as a loop over the two step signs, GCC 12 at -O3 dropped it
+// (tMax then differed from OctoMap's by 1e-8).
 template <typename T>
 class RayStarts {
 public:
@@ -86,7 +88,15 @@ public:
         : scan_(scan),
           origin_(scan.origin.cast<T>()),
           start_(scan.box.Index(scan.key_origin)),
-          strides_{scan.box.ny * scan.box.nz, scan.box.nz, 1} {}
+          strides_{scan.box.ny * scan.box.nz, scan.box.nz, 1},
+          // (T)(step * s * 0.5) is +-(T)(s * 0.5): rounding is symmetric.
+          half_(std::is_same_v<T, float> ? RoundToFloat(scan.voxel_size * 0.5)
+                                         : scan.voxel_size * 0.5) {
+        for (int a = 0; a < 3; ++a) {
+            centre_[a] = (static_cast<double>(scan.key_origin[a]) + 0.5) * scan.voxel_size;
+            origin_d_[a] = static_cast<double>(origin_[a]);
+        }
+    }
 
     /// The DDA of ray `i` (not a dropped point).
     [[nodiscard]] RaySetup operator()(size_t i) const {
@@ -110,9 +120,8 @@ public:
                 continue;
             }
             ray.stride[a] = step * strides_[a];
-            double border = (static_cast<double>(key_origin[a]) + 0.5) * s;
-            border += static_cast<T>(step * s * 0.5);
-            ray.t_max[a] = (border - static_cast<double>(origin_[a])) / direction[a];
+            const double border = centre_[a] + (step > 0 ? half_ : -half_);
+            ray.t_max[a] = (border - origin_d_[a]) / direction[a];
             ray.t_delta[a] = s / std::fabs(static_cast<double>(direction[a]));
         }
         return ray;
@@ -123,6 +132,8 @@ private:
     Vec3<T> origin_;
     int64_t start_;
     int64_t strides_[3];
+    double half_;  // half a voxel rounded to T, as OctoMap adds it
+    double centre_[3], origin_d_[3];
 };
 
 }  // namespace strata::integration::detail
