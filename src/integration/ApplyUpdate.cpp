@@ -41,10 +41,16 @@ void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float d
     const auto leaves = ActivateLeaves(mask, tree, masks);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& range) {
         for (size_t i = range.begin(); i != range.end(); ++i) {
+            // Word by word, bit by bit (count trailing zeros, clear the lowest bit): the mask's
+            // on-iterator costs twice the instructions per voxel.
             float* values = leaves[i]->buffer().data();
-            for (auto on = masks[i]->getValueMask().beginOn(); on; ++on) {
-                float& v = values[on.pos()];
-                v = std::clamp(v + delta, lo, hi);
+            const auto& bits = masks[i]->getValueMask();
+            for (openvdb::Index w = 0; w < MaskLeaf::NodeMaskType::WORD_COUNT; ++w) {
+                float* word_values = values + 64 * w;
+                for (uint64_t on = bits.template getWord<uint64_t>(w); on; on &= on - 1) {
+                    float& v = word_values[__builtin_ctzll(on)];
+                    v = std::clamp(v + delta, lo, hi);
+                }
             }
         }
     });
