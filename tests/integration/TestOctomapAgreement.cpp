@@ -134,7 +134,8 @@ TEST(OctomapAgreement, SingleRaysEndingOnVoxelCornersEqualOctomap) {
         differing += d.total();
         voxels += d.voxels_theirs;
     }
-    EXPECT_EQ(differing, 0u);
+    ::testing::Test::RecordProperty("voxels", std::to_string(voxels));
+    EXPECT_EQ(differing, 0u);  // 1,426 before the origin was rounded through RoundToFloat
     EXPECT_GT(voxels, 20000u);
 }
 
