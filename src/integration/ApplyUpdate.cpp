@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <memory>
 #include <vector>
 
 namespace strata::integration::detail {
@@ -17,6 +18,16 @@ using MaskLeaf = openvdb::MaskTree::LeafNodeType;
 // cached accessor walk per leaf: topologyUnion visits every child slot of every top-level node
 // (32^3 each, eight for a map around its origin), a fixed cost per scan larger than the work
 // (docs/integration.md, "Speed").
+// A mask given to ApplyOccupancyUpdate may come from a file and hold active tiles (a pruned
+// layer): those become leaves here, in `voxelized`, so that their voxels are updated as well.
+const openvdb::MaskTree& WithoutTiles(const openvdb::MaskTree& mask,
+                                      std::unique_ptr<openvdb::MaskTree>& voxelized) {
+    if (!mask.hasActiveTiles()) return mask;
+    voxelized = std::make_unique<openvdb::MaskTree>(mask);
+    voxelized->voxelizeActiveTiles();
+    return *voxelized;
+}
+
 template <typename TreeT>
 std::vector<typename TreeT::LeafNodeType*> ActivateLeaves(const openvdb::MaskTree& mask,
                                                           TreeT& tree,
@@ -35,10 +46,11 @@ std::vector<typename TreeT::LeafNodeType*> ActivateLeaves(const openvdb::MaskTre
 
 // Adds `delta` to every voxel of `mask` (an unobserved voxel starts at log-odds 0), clamped to
 // [lo, hi]: OctoMap's updateNodeLogOdds. Values are updated in parallel, one mask leaf per task.
-void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float delta, float lo,
+void AddLogOdds(const openvdb::MaskTree& given, openvdb::FloatTree& tree, float delta, float lo,
                 float hi) {
+    std::unique_ptr<openvdb::MaskTree> voxelized;
     std::vector<const MaskLeaf*> masks;
-    const auto leaves = ActivateLeaves(mask, tree, masks);
+    const auto leaves = ActivateLeaves(WithoutTiles(given, voxelized), tree, masks);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& range) {
         for (size_t i = range.begin(); i != range.end(); ++i) {
             // Word by word, bit by bit (count trailing zeros, clear the lowest bit): the mask's
@@ -72,8 +84,9 @@ void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map,
     // values straight in the leaf buffers; groups come sorted, so consecutive groups mostly share
     // a leaf. The mean is a running mean over all scans (core/Endpoints.hpp, Accumulate).
     openvdb::Int32Tree& endpoints = map.endpoints->tree();
+    std::unique_ptr<openvdb::MaskTree> voxelized;
     std::vector<const MaskLeaf*> masks;
-    (void)ActivateLeaves(*update.occupied, endpoints, masks);
+    (void)ActivateLeaves(WithoutTiles(*update.occupied, voxelized), endpoints, masks);
     openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(endpoints);
     const double s = map.voxel_size;
     openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
