@@ -103,9 +103,9 @@ TEST(OctomapAgreement, SeveralSyntheticScansEqualOctomapIncludingClamping) {
 }
 
 // One ray per map, so that no other ray's voxels hide a wrong one: the walk skips its stopping
-// tests on all but its last steps (MarkScan.cpp, TraceRay), which must leave every voxel where
-// OctoMap's walk puts it. Rays of 1 to 70 steps from voxel corners or anywhere, ending on voxel
-// corners, edges and face centres, where rounding decides the last voxels.
+// tests on all but its last steps (TraceRay.hpp), which must leave every voxel where
+// OctoMap's walk puts it. Rays of 1 to about 120 steps from voxel corners or anywhere, ending on
+// voxel corners, edges and face centres, where rounding decides the last voxels.
 TEST(OctomapAgreement, SingleRaysEndingOnVoxelCornersEqualOctomap) {
     constexpr double kVoxel = 0.2;
     std::mt19937 rng(19);
