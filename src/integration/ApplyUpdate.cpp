@@ -1,44 +1,71 @@
 #include "ApplyUpdate.hpp"
 
-#include <openvdb/tree/LeafManager.h>
-#include <openvdb/tree/ValueAccessor.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <memory>
 #include <vector>
 
 namespace strata::integration::detail {
 namespace {
 
-// Adds `delta` to every voxel of `mask` (an unobserved voxel starts at log-odds 0), clamped to
-// [lo, hi]: OctoMap's updateNodeLogOdds. The leaves under the mask are made first, serially
-// (topology changes are not thread-safe; consecutive mask leaves share their internal nodes, so
-// one accessor finds each in a few steps; newly observed voxels take the background, 0, and an
-// active tile under the mask becomes a leaf), then every leaf is updated in parallel.
-void AddLogOdds(const openvdb::MaskTree& mask, openvdb::FloatTree& tree, float delta, float lo,
-                float hi) {
-    std::vector<const openvdb::MaskTree::LeafNodeType*> masks;
-    masks.reserve(mask.leafCount());
-    for (auto it = mask.cbeginLeaf(); it; ++it) masks.push_back(it.getLeaf());
-    std::vector<openvdb::FloatTree::LeafNodeType*> leaves(masks.size());
-    {
-        openvdb::tree::ValueAccessor<openvdb::FloatTree> acc(tree);
-        for (size_t i = 0; i < masks.size(); ++i) leaves[i] = acc.touchLeaf(masks[i]->origin());
+using MaskLeaf = openvdb::MaskTree::LeafNodeType;
+
+// Activates every voxel of `mask` in `tree` (tree.topologyUnion(mask): newly observed voxels keep
+// the value they hold, the background; active tiles under the mask become leaves) and returns,
+// per mask leaf, the tree's leaf at its origin. Serial, as topology changes must be, but one
+// cached accessor walk per leaf: topologyUnion visits every child slot of every top-level node
+// (32^3 each, eight for a map around its origin), a fixed cost per scan larger than the work
+// (docs/integration.md, "Speed").
+// A mask given to ApplyOccupancyUpdate may come from a file and hold active tiles (a pruned
+// layer): those become leaves here, in `voxelized`, so that their voxels are updated as well.
+const openvdb::MaskTree& WithoutTiles(const openvdb::MaskTree& mask,
+                                      std::unique_ptr<openvdb::MaskTree>& voxelized) {
+    if (!mask.hasActiveTiles()) return mask;
+    voxelized = std::make_unique<openvdb::MaskTree>(mask);
+    voxelized->voxelizeActiveTiles();
+    return *voxelized;
+}
+
+template <typename TreeT>
+std::vector<typename TreeT::LeafNodeType*> ActivateLeaves(const openvdb::MaskTree& mask,
+                                                          TreeT& tree,
+                                                          std::vector<const MaskLeaf*>& masks) {
+    std::vector<typename TreeT::LeafNodeType*> leaves;
+    masks.clear();
+    openvdb::tree::ValueAccessor<TreeT> acc(tree);
+    for (auto it = mask.cbeginLeaf(); it; ++it) {
+        auto* leaf = acc.touchLeaf(it->origin());
+        leaf->getValueMask() |= it->getValueMask();
+        leaves.push_back(leaf);
+        masks.push_back(&*it);
     }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, masks.size()),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                          for (size_t i = range.begin(); i != range.end(); ++i) {
-                              const auto& on_mask = masks[i]->getValueMask();
-                              openvdb::FloatTree::LeafNodeType& leaf = *leaves[i];
-                              float* values = leaf.buffer().data();
-                              for (auto on = on_mask.beginOn(); on; ++on) {
-                                  float& v = values[on.pos()];
-                                  v = std::clamp(v + delta, lo, hi);
-                              }
-                              leaf.getValueMask() |= on_mask;
-                          }
-                      });
+    return leaves;
+}
+
+// Adds `delta` to every voxel of `mask` (an unobserved voxel starts at log-odds 0), clamped to
+// [lo, hi]: OctoMap's updateNodeLogOdds. Values are updated in parallel, one mask leaf per task.
+void AddLogOdds(const openvdb::MaskTree& given, openvdb::FloatTree& tree, float delta, float lo,
+                float hi) {
+    std::unique_ptr<openvdb::MaskTree> voxelized;
+    std::vector<const MaskLeaf*> masks;
+    const auto leaves = ActivateLeaves(WithoutTiles(given, voxelized), tree, masks);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& range) {
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            // Word by word, bit by bit (count trailing zeros, clear the lowest bit): the mask's
+            // on-iterator costs twice the instructions per voxel.
+            float* values = leaves[i]->buffer().data();
+            const auto& bits = masks[i]->getValueMask();
+            for (openvdb::Index w = 0; w < MaskLeaf::NodeMaskType::WORD_COUNT; ++w) {
+                float* word_values = values + 64 * w;
+                for (uint64_t on = bits.template getWord<uint64_t>(w); on; on &= on - 1) {
+                    float& v = word_values[__builtin_ctzll(on)];
+                    v = std::clamp(v + delta, lo, hi);
+                }
+            }
+        }
+    });
 }
 
 }  // namespace
@@ -51,18 +78,21 @@ void ApplyOccupancy(const ScanUpdate& update, openvdb::FloatGrid& occupancy,
     AddLogOdds(*update.occupied, occupancy.tree(), core::LogOdds(config.prob_hit), lo, hi);
 }
 
-void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map, const IntegrationConfig& config) {
-    // Hits and mean endpoint, packed in one value: activate every endpoint voxel (parallel
-    // topologyUnion), then update the values straight in the leaf buffers; groups come sorted, so
-    // consecutive groups mostly share a leaf. The mean is a running mean over all scans
-    // (core/Endpoints.hpp, Accumulate).
+void ApplyEndpoints(const ScanUpdate& update, core::VoxelMap& map,
+                    const IntegrationConfig& config) {
+    // Hits and mean endpoint, packed in one value: activate every endpoint voxel, then update the
+    // values straight in the leaf buffers; groups come sorted, so consecutive groups mostly share
+    // a leaf. The mean is a running mean over all scans (core/Endpoints.hpp, Accumulate).
     openvdb::Int32Tree& endpoints = map.endpoints->tree();
-    endpoints.topologyUnion(*update.occupied);
+    std::unique_ptr<openvdb::MaskTree> voxelized;
+    std::vector<const MaskLeaf*> masks;
+    (void)ActivateLeaves(WithoutTiles(*update.occupied, voxelized), endpoints, masks);
+    openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(endpoints);
     const double s = map.voxel_size;
     openvdb::Int32Tree::LeafNodeType* leaf = nullptr;
     for (const EndpointGroup& g : update.endpoints) {
         const openvdb::Coord origin(g.ijk.x() & ~7, g.ijk.y() & ~7, g.ijk.z() & ~7);
-        if (!leaf || origin != leaf->origin()) leaf = endpoints.probeLeaf(g.ijk);
+        if (!leaf || origin != leaf->origin()) leaf = acc.probeLeaf(g.ijk);
         int32_t& packed = leaf->buffer().data()[leaf->coordToOffset(g.ijk)];
         packed = config.keep_point_means
                      ? core::endpoint::Accumulate(packed, g.points, g.offset_sum, s, g.ijk)

@@ -1,10 +1,10 @@
 #include "strata/integration/IntegrationConfig.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::integration {
 namespace {

@@ -1,7 +1,5 @@
 #include "strata/integration/Integrator.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -13,6 +11,7 @@
 #include "ApplyUpdate.hpp"
 #include "RadixSort.hpp"
 #include "RayMarking.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::integration {
 namespace {

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "RayMarking.hpp"
+#include "TraceRay.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::integration::detail {
@@ -40,56 +41,6 @@ struct Bitmap {
     }
 };
 
-// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel, then every voxel the walk enters
-// until it enters the end voxel or a voxel it would leave beyond the ray's length (OctoMap's
-// guard against rounding near the end: such a voxel is not marked). The exit distance of the
-// current voxel is the smallest tMax, which is the one the walk steps on, so the guard costs one
-// comparison per step. The box check bounds every write, whatever the rounding does; the box's
-// padding of one voxel holds every voxel the walk can enter, so it never cuts a ray short.
-template <typename MarkFn>
-inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark) {
-    if (ray.start == ray.end) return;  // origin and end share a voxel: no free cells
-    // Locals, not members: the marks are stores the compiler cannot prove apart from `ray`, so
-    // values read through `ray` would be reloaded after every store.
-    int64_t pos = ray.start;
-    const int64_t end = ray.end;
-    const int64_t s0 = ray.stride[0], s1 = ray.stride[1], s2 = ray.stride[2];
-    const double d0 = ray.t_delta[0], d1 = ray.t_delta[1], d2 = ray.t_delta[2];
-    const double length = ray.length;
-    double t0 = ray.t_max[0], t1 = ray.t_max[1], t2 = ray.t_max[2];
-    mark(pos);  // OctoMap adds the origin's key before any test
-    for (;;) {
-        // Same tie-breaking as OctoMap: x before z, y before z, y before x only when strictly less.
-        // The exit distance of voxel `pos` is the tMax the walk steps on: beyond the length, the
-        // voxel is not marked and the walk ends. (For the origin voxel, marked above, ending here
-        // gives OctoMap's set too: exit distances never decrease along the walk.)
-        if (t0 < t1) {
-            if (t0 < t2) {
-                if (t0 > length) return;
-                mark(pos);
-                t0 += d0;
-                pos += s0;
-            } else {
-                if (t2 > length) return;
-                mark(pos);
-                t2 += d2;
-                pos += s2;
-            }
-        } else if (t1 < t2) {
-            if (t1 > length) return;
-            mark(pos);
-            t1 += d1;
-            pos += s1;
-        } else {
-            if (t2 > length) return;
-            mark(pos);
-            t2 += d2;
-            pos += s2;
-        }
-        if (pos == end || static_cast<uint64_t>(pos) >= box_size) return;
-    }
-}
-
 size_t RayCount(const PreparedScan& scan) { return scan.points_only ? 0 : scan.ends.size(); }
 
 // One 8x8x8 brick of a bitmap as the eight 64-bit words of a VDB leaf mask (offset x<<6|y<<3|z:
@@ -107,6 +58,34 @@ void GatherBrick(const VoxelBox& box, const uint8_t* bytes, int64_t bx, int64_t 
     }
 }
 
+// Which bricks of the column (bx, by, every z) have a bit set in any of `bitmaps`: `any[k]` for
+// the brick at z = 8k; false when none has. Each of the column's 8 x-slabs holds its 8 rows of z
+// next to each other (nz bytes from a multiple of 8), so the slabs OR together word by word, then
+// the rows byte by byte: a few hundred instructions where the byte gathers of every brick cost
+// a few thousand, and most bricks of a scan's box are empty (its corners, the gaps between far
+// rays, the sky).
+bool FindBricks(const VoxelBox& box, const std::vector<const uint64_t*>& bitmaps, int64_t bx,
+                int64_t by, std::vector<uint64_t>& acc, std::vector<uint8_t>& any) {
+    const int64_t row = box.nz >> 3, slab = box.ny * row;
+    acc.assign(static_cast<size_t>(row), 0);  // nz bytes as words
+    for (const uint64_t* bits : bitmaps) {
+        for (int64_t x = bx; x < bx + 8; ++x) {
+            const uint64_t* p = bits + ((x * slab + by * row) >> 3);
+            for (int64_t w = 0; w < row; ++w) acc[w] |= p[w];
+        }
+    }
+    const auto* bytes = reinterpret_cast<const uint8_t*>(acc.data());
+    any.resize(static_cast<size_t>(row));
+    uint8_t all = 0;
+    for (int64_t k = 0; k < row; ++k) {
+        uint8_t b = 0;
+        for (int64_t y = 0; y < 8; ++y) b |= bytes[y * row + k];
+        any[k] = b;
+        all |= b;
+    }
+    return all != 0;
+}
+
 ScanMasks MarkDense(const PreparedScan& scan) {
     const VoxelBox& box = scan.box;
     const auto n_bytes = static_cast<size_t>(box.size() / 8);
@@ -117,25 +96,31 @@ ScanMasks MarkDense(const PreparedScan& scan) {
                           const auto mark = [bits](int64_t pos) {
                               bits[pos >> 6] |= uint64_t{1} << (pos & 63);
                           };
-                          for (size_t i = range.begin(); i != range.end(); ++i) {
-                              TraceRay(SetupRay(scan, i), static_cast<uint64_t>(box.size()), mark);
-                          }
+                          TraceRays(scan, range, mark, bits);
                       });
     Bitmap occupied_bits(n_bytes);
     for (const int64_t pos : scan.endpoint_pos) occupied_bits.Set(pos);
 
     // Bricks to leaves, parallel over x-slabs of bricks; free minus occupied (occupied wins).
     std::vector<const uint8_t*> locals;
-    for (const Bitmap& b : free_bits) locals.push_back(b.bytes());
+    std::vector<const uint64_t*> all_words = {occupied_bits.words.get()};
+    for (const Bitmap& b : free_bits) {
+        locals.push_back(b.bytes());
+        all_words.push_back(b.words.get());
+    }
     // Each thread fills its own trees; merging them afterwards only moves nodes.
     tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees, occ_trees;
     tbb::parallel_for(tbb::blocked_range<int64_t>(0, box.nx / 8), [&](const auto& range) {
         openvdb::MaskTree& my_free = free_trees.local();
         openvdb::MaskTree& my_occ = occ_trees.local();
         uint64_t occ[8], fre[8], tmp[8];
+        std::vector<uint64_t> acc;
+        std::vector<uint8_t> any;
         for (int64_t bx = range.begin() * 8; bx != range.end() * 8; bx += 8) {
             for (int64_t by = 0; by < box.ny; by += 8) {
+                if (!FindBricks(box, all_words, bx, by, acc, any)) continue;
                 for (int64_t bz = 0; bz < box.nz; bz += 8) {
+                    if (!any[bz >> 3]) continue;
                     GatherBrick(box, occupied_bits.bytes(), bx, by, bz, occ);
                     uint64_t any_free = 0, any_occ = 0;
                     std::memset(fre, 0, sizeof(fre));
@@ -177,10 +162,9 @@ ScanMasks MarkSparse(const PreparedScan& scan) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
                           openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(free_trees.local());
-                          for (size_t i = range.begin(); i != range.end(); ++i) {
-                              TraceRay(SetupRay(scan, i), static_cast<uint64_t>(box.size()),
-                                       [&](int64_t pos) { acc.setValueOn(box.CoordOf(pos)); });
-                          }
+                          TraceRays(
+                              scan, range, [&](int64_t pos) { acc.setValueOn(box.CoordOf(pos)); },
+                              nullptr);
                       });
     ScanMasks masks;
     for (const auto& tree : free_trees) masks.free->topologyUnion(tree);

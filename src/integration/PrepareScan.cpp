@@ -9,9 +9,8 @@
 #include <stdexcept>
 
 #include "RayArithmetic.hpp"
-
-#include "strata/core/Error.hpp"
 #include "RayMarking.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::integration::detail {
 namespace {
@@ -41,36 +40,38 @@ VoxelBox MakeBox(openvdb::CoordBBox bbox) {
     bbox.expand(1);  // one voxel of padding: a ray's rounding can never leave the box
     VoxelBox box;
     box.lo = openvdb::Coord(bbox.min().x() & ~7, bbox.min().y() & ~7, bbox.min().z() & ~7);
+    // z, the fastest axis, to a multiple of 64 voxels: a bitmap row is then whole words, and
+    // an x or y step of a walk moves by whole words (TraceRay.hpp, WordCursor).
     const openvdb::Coord hi((bbox.max().x() | 7) + 1, (bbox.max().y() | 7) + 1,
-                            (bbox.max().z() | 7) + 1);
+                            box.lo.z() + ((bbox.max().z() - box.lo.z()) | 63) + 1);
     box.nx = int64_t{hi.x()} - box.lo.x();
     box.ny = int64_t{hi.y()} - box.lo.y();
     box.nz = int64_t{hi.z()} - box.lo.z();
     if (box.nx > kMaxBoxExtent || box.ny > kMaxBoxExtent || box.nz > kMaxBoxExtent ||
         box.size() >= kMaxBoxVoxels) {
-        throw InvalidArgumentError("a scan spans more than 2^20 voxels along one axis; use a "
-                                    "larger voxel size or a smaller max range");
+        throw InvalidArgumentError(
+            "a scan spans more than 2^20 voxels along one axis; use a "
+            "larger voxel size or a smaller max range");
     }
     return box;
 }
 
 }  // namespace
 
-RaySetup SetupRay(const PreparedScan& scan, size_t i) {
-    if (scan.points_only || scan.kinds[i] == PointKind::kDropped) return {};  // no free cells
-    return scan.float_rays ? SetupRayIn<float>(scan, i) : SetupRayIn<double>(scan, i);
-}
-
 PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                          const Eigen::Vector3d& origin_map, double voxel_size,
                          const IntegrationConfig& config) {
     const double inv_voxel = 1.0 / voxel_size;
     if (!origin_map.allFinite() || !KeyInRange(origin_map, inv_voxel)) {
-        throw InvalidArgumentError("the sensor origin is not finite or too far from the map origin");
+        throw InvalidArgumentError(
+            "the sensor origin is not finite or too far from the map origin");
     }
     PreparedScan scan;
     scan.float_rays = UseFloatRays(origin_map, inv_voxel, config);
-    scan.origin = scan.float_rays ? origin_map.cast<float>().cast<double>() : origin_map;
+    scan.origin = origin_map;
+    if (scan.float_rays) {
+        for (int a = 0; a < 3; ++a) scan.origin[a] = RoundToFloat(origin_map[a]);
+    }
     scan.key_origin = Key(scan.origin, inv_voxel);
     scan.voxel_size = voxel_size;
     scan.inv_voxel_size = inv_voxel;
@@ -83,8 +84,8 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
     const auto classify = [&](auto zero, size_t i) {
         using T = decltype(zero);
         Vec3<T> end = Vec3<T>::Zero();
-        scan.kinds[i] = ClassifyPoint<T>(points_map[i].cast<T>(), scan.origin.cast<T>(),
-                                         inv_voxel, config, end);
+        scan.kinds[i] = ClassifyPoint<T>(points_map[i].cast<T>(), scan.origin.cast<T>(), inv_voxel,
+                                         config, end);
         scan.ends[i] = end.template cast<double>();
     };
     using Range = tbb::blocked_range<size_t>;
@@ -112,7 +113,8 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
     std::vector<int64_t> pos(n);
     tbb::parallel_for(Range(0, n, kPointGrain), [&](const Range& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            if (scan.kinds[i] == PointKind::kHit) pos[i] = scan.box.Index(Key(scan.ends[i], inv_voxel));
+            if (scan.kinds[i] == PointKind::kHit)
+                pos[i] = scan.box.Index(Key(scan.ends[i], inv_voxel));
         }
     });
     scan.endpoint_pos.reserve(n);

@@ -9,8 +9,7 @@
 namespace strata::integration::detail {
 
 // `payload` (one value per key, or empty) is permuted along with the keys; the sort is stable.
-inline void RadixSort(std::vector<uint64_t>& keys, int key_bits,
-                      std::vector<uint32_t>& payload) {
+inline void RadixSort(std::vector<uint64_t>& keys, int key_bits, std::vector<uint32_t>& payload) {
     constexpr int kDigitBits = 11;
     constexpr size_t kBuckets = size_t{1} << kDigitBits;
     const bool carry = !payload.empty();

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "RayMarking.hpp"
 
@@ -24,6 +25,15 @@ using Vec3 = Eigen::Matrix<T, 3, 1>;
 inline int32_t FloorToInt(double v) {
     const auto i = static_cast<int32_t>(v);
     return i - static_cast<int32_t>(v < i);
+}
+
+// (double)(float)v, as OctoMap's point3d holds the sensor origin. Through a volatile float: GCC
+// 12 at -O3 dropped the rounding of x and y in PrepareScan's `v.cast<float>().cast<double>()`
+// (the origin's key then differed from OctoMap's for a sensor within 1e-8 m of a voxel face:
+// OctomapAgreement.SingleRaysEndingOnVoxelCornersEqualOctomap, sensor at y = -0.4 m).
+inline double RoundToFloat(double v) {
+    volatile float rounded = static_cast<float>(v);
+    return rounded;
 }
 
 // OctoMap's coordToKey: floor(coordinate / resolution), the coordinate taken as double.
@@ -50,7 +60,8 @@ PointKind ClassifyPoint(const Vec3<T>& p, const Vec3<T>& origin, double inv_voxe
     constexpr double kKeyLimit = 1e9;  // keys stay far from int32 overflow
     const Vec3<T> ray = p - origin;
     const double range = Norm(ray);
-    if (!p.allFinite() || (p.template cast<double>() * inv_voxel).cwiseAbs().maxCoeff() >= kKeyLimit ||
+    if (!p.allFinite() ||
+        (p.template cast<double>() * inv_voxel).cwiseAbs().maxCoeff() >= kKeyLimit ||
         range < config.min_range_m) {
         return PointKind::kDropped;
     }
@@ -65,35 +76,64 @@ PointKind ClassifyPoint(const Vec3<T>& p, const Vec3<T>& origin, double inv_voxe
 }
 
 // computeRayKeys' initialisation: the direction normalised in T, the voxel border offset rounded
-// to T, tMax and tDelta in double; an axis the direction does not move along never steps.
+// to T, tMax and tDelta in double; an axis the direction does not move along never steps. What
+// does not depend on the ray (the origin, its box index, the strides, the origin voxel's centre
+// and half a voxel rounded to T) is computed once, by the same operations. The rounding goes
+// through RoundToFloat: written as a loop over the two step signs, GCC 12 at -O3 dropped it
+// (tMax then differed from OctoMap's by 1e-8).
 template <typename T>
-RaySetup SetupRayIn(const PreparedScan& scan, size_t i) {
-    RaySetup ray;  // start == end: no free cells
-    const Vec3<T> end = scan.ends[i].cast<T>();
-    const Vec3<T> origin = scan.origin.cast<T>();
-    const openvdb::Coord& key_origin = scan.key_origin;
-    ray.start = scan.box.Index(key_origin);
-    ray.end = scan.box.Index(Key(end, scan.inv_voxel_size));
-    if (ray.start == ray.end) return ray;
-    Vec3<T> direction = end - origin;
-    const auto length = static_cast<T>(Norm(direction));
-    for (int a = 0; a < 3; ++a) direction[a] /= length;
-    ray.length = length;
-    const double s = scan.voxel_size;
-    const int64_t strides[3] = {scan.box.ny * scan.box.nz, scan.box.nz, 1};
-    for (int a = 0; a < 3; ++a) {
-        const int step = direction[a] > T(0) ? 1 : (direction[a] < T(0) ? -1 : 0);
-        if (step == 0) {
-            ray.t_max[a] = ray.t_delta[a] = std::numeric_limits<double>::max();
-            continue;
+class RayStarts {
+public:
+    explicit RayStarts(const PreparedScan& scan)
+        : scan_(scan),
+          origin_(scan.origin.cast<T>()),
+          start_(scan.box.Index(scan.key_origin)),
+          strides_{scan.box.ny * scan.box.nz, scan.box.nz, 1},
+          // (T)(step * s * 0.5) is +-(T)(s * 0.5): rounding is symmetric.
+          half_(std::is_same_v<T, float> ? RoundToFloat(scan.voxel_size * 0.5)
+                                         : scan.voxel_size * 0.5) {
+        for (int a = 0; a < 3; ++a) {
+            centre_[a] = (static_cast<double>(scan.key_origin[a]) + 0.5) * scan.voxel_size;
+            origin_d_[a] = static_cast<double>(origin_[a]);
         }
-        ray.stride[a] = step * strides[a];
-        double border = (static_cast<double>(key_origin[a]) + 0.5) * s;
-        border += static_cast<T>(step * s * 0.5);
-        ray.t_max[a] = (border - static_cast<double>(origin[a])) / direction[a];
-        ray.t_delta[a] = s / std::fabs(static_cast<double>(direction[a]));
     }
-    return ray;
-}
+
+    /// The DDA of ray `i` (not a dropped point).
+    [[nodiscard]] RaySetup operator()(size_t i) const {
+        RaySetup ray;  // start == end: no free cells
+        const Vec3<T> end = scan_.ends[i].template cast<T>();
+        const openvdb::Coord& key_origin = scan_.key_origin;
+        const openvdb::Coord key_end = Key(end, scan_.inv_voxel_size);
+        ray.start = start_;
+        ray.end = scan_.box.Index(key_end);
+        if (ray.start == ray.end) return ray;
+        for (int a = 0; a < 3; ++a) ray.steps += std::abs(int64_t{key_end[a]} - key_origin[a]);
+        Vec3<T> direction = end - origin_;
+        const auto length = static_cast<T>(Norm(direction));
+        for (int a = 0; a < 3; ++a) direction[a] /= length;
+        ray.length = length;
+        const double s = scan_.voxel_size;
+        for (int a = 0; a < 3; ++a) {
+            const int step = direction[a] > T(0) ? 1 : (direction[a] < T(0) ? -1 : 0);
+            if (step == 0) {
+                ray.t_max[a] = ray.t_delta[a] = std::numeric_limits<double>::max();
+                continue;
+            }
+            ray.stride[a] = step * strides_[a];
+            const double border = centre_[a] + (step > 0 ? half_ : -half_);
+            ray.t_max[a] = (border - origin_d_[a]) / direction[a];
+            ray.t_delta[a] = s / std::fabs(static_cast<double>(direction[a]));
+        }
+        return ray;
+    }
+
+private:
+    const PreparedScan& scan_;
+    Vec3<T> origin_;
+    int64_t start_;
+    int64_t strides_[3];
+    double half_;  // half a voxel rounded to T, as OctoMap adds it
+    double centre_[3], origin_d_[3];
+};
 
 }  // namespace strata::integration::detail

@@ -14,9 +14,10 @@
 namespace strata::integration::detail {
 
 /// The box of voxels a scan can touch, padded by one voxel and aligned to 8 (VDB leaves), so a
-/// brick of the box is exactly one leaf. `pos` values are linear indices into it, z fastest.
+/// brick of the box is exactly one leaf; its z extent is a multiple of 64. `pos` values are linear
+/// indices into it, z fastest.
 struct VoxelBox {
-    openvdb::Coord lo;           // first voxel, multiple of 8 in each axis
+    openvdb::Coord lo;               // first voxel, multiple of 8 in each axis
     int64_t nx = 0, ny = 0, nz = 0;  // extents, multiples of 8
 
     [[nodiscard]] int64_t size() const { return nx * ny * nz; }
@@ -45,7 +46,8 @@ private:
 /// and OctoMap's computeRayKeys quantities (tMax, tDelta, length, in metres).
 struct RaySetup {
     int64_t start = 0;
-    int64_t end = 0;  // == start: origin and end share a voxel, no free cells
+    int64_t end = 0;    // == start: origin and end share a voxel, no free cells
+    int64_t steps = 0;  // L1 key distance from start to end: the one step count that can reach it
     int64_t stride[3] = {0, 0, 0};
     double t_max[3] = {0, 0, 0};
     double t_delta[3] = {0, 0, 0};
@@ -60,17 +62,17 @@ struct PreparedScan {
     VoxelBox box;
     /// Rays in OctoMap's float arithmetic (origin and ends are then float values); else double.
     bool float_rays = true;
-    Eigen::Vector3d origin;             // sensor origin, map frame
+    Eigen::Vector3d origin;  // sensor origin, map frame
     openvdb::Coord key_origin;
     double voxel_size = 0.0;
     double inv_voxel_size = 0.0;  // keys are floor(p * inv_voxel_size), as OctoMap's
     bool points_only = false;
-    std::vector<Eigen::Vector3d> ends;  // per point: the point, or the ray clipped to max range
-    std::vector<PointKind> kinds;       // per point
-    std::vector<int64_t> endpoint_pos;   // box index of every hit, scan order
+    std::vector<Eigen::Vector3d> ends;     // per point: the point, or the ray clipped to max range
+    std::vector<PointKind> kinds;          // per point
+    std::vector<int64_t> endpoint_pos;     // box index of every hit, scan order
     std::vector<uint32_t> endpoint_point;  // index of that hit's point in the scan
-    size_t dropped = 0;                  // NaN/inf or closer than min_range
-    size_t clipped = 0;                  // longer than max_range: free space only
+    size_t dropped = 0;                    // NaN/inf or closer than min_range
+    size_t clipped = 0;                    // longer than max_range: free space only
 };
 
 /// Filters points, computes the box and the endpoint voxels (parallel over points).
@@ -78,9 +80,6 @@ struct PreparedScan {
 [[nodiscard]] PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                                        const Eigen::Vector3d& origin_map, double voxel_size,
                                        const IntegrationConfig& config);
-
-/// OctoMap's initialisation of tMax/tDelta for the ray of point `i`.
-[[nodiscard]] RaySetup SetupRay(const PreparedScan& scan, size_t i);
 
 /// The free and occupied voxels of a scan as VDB masks, free minus occupied (occupied wins).
 struct ScanMasks {

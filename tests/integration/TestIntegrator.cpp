@@ -1,7 +1,3 @@
-#include "strata/integration/Integrator.hpp"
-
-#include "strata/core/Error.hpp"
-
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -9,6 +5,9 @@
 #include <random>
 #include <set>
 #include <tuple>
+
+#include "strata/core/Error.hpp"
+#include "strata/integration/Integrator.hpp"
 
 namespace strata::integration {
 namespace {
@@ -56,8 +55,8 @@ TEST(Integrator, HandCheckedRayCrossesExpectedVoxels) {
     // 1 m voxels, ray from (0.5, 0.5, 0.5) to (3.5, 2.5, 0.5): y = 0.5 + 2/3 (x - 0.5) crosses
     // x=1 (y=.83), y=1 (x=1.25), x=2 (y=1.5), y=2 (x=2.75), x=3 (end voxel).
     core::VoxelMap map = core::VoxelMap::Create(1.0);
-    const auto update = ComputeScanUpdate(
-        MakeScan({{3.5, 2.5, 0.5}}, {0.5, 0.5, 0.5}), map, IntegrationConfig{});
+    const auto update =
+        ComputeScanUpdate(MakeScan({{3.5, 2.5, 0.5}}, {0.5, 0.5, 0.5}), map, IntegrationConfig{});
     EXPECT_EQ(ActiveVoxels(*update.free),
               (std::set<Key>{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {2, 1, 0}, {2, 2, 0}}));
     EXPECT_EQ(ActiveVoxels(*update.occupied), (std::set<Key>{{3, 2, 0}}));
@@ -72,8 +71,8 @@ TEST(Integrator, HandCheckedRayCrossesExpectedVoxels) {
 TEST(Integrator, NegativeCoordinatesFollowFloorConvention) {
     // Voxel (i) covers [i*s, (i+1)*s): -0.05 at 0.1 m is voxel -1, as in OctoMap.
     core::VoxelMap map = core::VoxelMap::Create(0.1);
-    const auto update = ComputeScanUpdate(MakeScan({{-0.05, -0.15, 0.05}}, {0.05, 0.05, 0.05}),
-                                          map, IntegrationConfig{});
+    const auto update = ComputeScanUpdate(MakeScan({{-0.05, -0.15, 0.05}}, {0.05, 0.05, 0.05}), map,
+                                          IntegrationConfig{});
     EXPECT_EQ(ActiveVoxels(*update.occupied), (std::set<Key>{{-1, -2, 0}}));
 }
 
@@ -81,9 +80,8 @@ TEST(Integrator, UpdatesEveryVoxelAtMostOncePerScan) {
     core::VoxelMap map = core::VoxelMap::Create(1.0);
     Integrator integrator(map, IntegrationConfig{});
     // Three identical rays and one parallel ray through the same voxels.
-    integrator.Integrate(MakeScan({{5.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, {5.5, 0.5, 0.5},
-                                   {5.6, 0.6, 0.5}},
-                                  {0.5, 0.5, 0.5}));
+    integrator.Integrate(MakeScan(
+        {{5.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, {5.6, 0.6, 0.5}}, {0.5, 0.5, 0.5}));
     EXPECT_NEAR(map.occupancy->tree().getValue({2, 0, 0}), core::LogOdds(0.4), kValueTol);
     EXPECT_NEAR(map.occupancy->tree().getValue({5, 0, 0}), core::LogOdds(0.7), kValueTol);
     EXPECT_EQ(map.Hits({5, 0, 0}), 4);  // hits count points, not updates
@@ -160,6 +158,25 @@ TEST(Integrator, ClampsLogOddsLikeOctomap) {
     for (int i = 0; i < 20; ++i) integrator.Integrate(scan);
     EXPECT_NEAR(map.occupancy->tree().getValue({4, 0, 0}), core::LogOdds(0.971), kValueTol);
     EXPECT_NEAR(map.occupancy->tree().getValue({1, 0, 0}), core::LogOdds(0.1192), kValueTol);
+}
+
+// A mask read back from a file may hold active tiles: every voxel under one is updated, as if
+// the mask held the tile's leaf.
+TEST(Integrator, OccupancyUpdateCoversTheVoxelsOfAMasksTiles) {
+    openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
+    // One 8^3 tile (a fill that covers a whole leaf stores a tile) and one voxel.
+    mask->sparseFill(openvdb::CoordBBox({8, 0, 0}, {15, 7, 7}), true, true);
+    mask->tree().setValueOn(openvdb::Coord(-1, 0, 0));
+    ASSERT_TRUE(mask->tree().hasActiveTiles());
+    ScanUpdate update;
+    update.free = mask->treePtr();
+    update.occupied = std::make_shared<openvdb::MaskTree>();
+    openvdb::FloatGrid occupancy;
+    const IntegrationConfig config;
+    ApplyOccupancyUpdate(update, occupancy, config);
+    EXPECT_EQ(occupancy.activeVoxelCount(), 513u);
+    EXPECT_NEAR(occupancy.tree().getValue({15, 7, 7}), core::LogOdds(config.prob_miss), kValueTol);
+    EXPECT_NEAR(occupancy.tree().getValue({-1, 0, 0}), core::LogOdds(config.prob_miss), kValueTol);
 }
 
 TEST(Integrator, LabelFlipsOnlyWhenOutweighed) {

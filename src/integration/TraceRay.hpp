@@ -1,0 +1,162 @@
+#pragma once
+// Private to the integrator: the walk of one ray (OctoMap's computeRayKeys) and of a range of a
+// scan's rays, marking each voxel it enters through `mark`.
+
+#include <tbb/blocked_range.h>
+
+#include <cstdint>
+
+#include "RayArithmetic.hpp"
+#include "RayMarking.hpp"
+
+namespace strata::integration::detail {
+
+// Where a walk marks during its first steps. PosCursor: a box index, marked through `mark`.
+// WordCursor: a word index and a one-bit mask into a dense bitmap whose z extent is a multiple
+// of 64 (VoxelBox), so an x or y step moves whole words and a mark is one OR; a z step rotates
+// the bit, carrying into the next word.
+template <typename MarkFn>
+struct PosCursor {
+    int64_t pos;
+    int64_t s0, s1, s2;
+    MarkFn& mark;
+    void StepX() { pos += s0; }
+    void StepY() { pos += s1; }
+    void StepZ() { pos += s2; }
+    void Mark() { mark(pos); }
+    [[nodiscard]] int64_t Pos() const { return pos; }
+};
+
+struct WordCursor {
+    uint64_t* words;
+    int64_t index;
+    uint64_t bit;
+    int64_t w0, w1;  // x and y strides in words
+    bool z_up;
+    void StepX() { index += w0; }
+    void StepY() { index += w1; }
+    void StepZ() {
+        if (z_up) {
+            const uint64_t carry = bit >> 63;
+            bit = bit << 1 | carry;
+            index += static_cast<int64_t>(carry);
+        } else {
+            const uint64_t carry = bit & 1;
+            bit = bit >> 1 | carry << 63;
+            index -= static_cast<int64_t>(carry);
+        }
+    }
+    void Mark() { words[index] |= bit; }
+    [[nodiscard]] int64_t Pos() const { return index * 64 + __builtin_ctzll(bit); }
+};
+
+// `k` steps without the stopping tests (see TraceRay), with OctoMap's tie-breaking: x before z,
+// y before z, y before x only when strictly less.
+template <typename Cursor>
+inline void StepsWithoutTests(int64_t k, double (&t)[3], const double (&d)[3], Cursor& at) {
+    double t0 = t[0], t1 = t[1], t2 = t[2];
+    for (; k > 0; --k) {
+        if (t0 < t1) {
+            if (t0 < t2) {
+                t0 += d[0];
+                at.StepX();
+            } else {
+                t2 += d[2];
+                at.StepZ();
+            }
+        } else if (t1 < t2) {
+            t1 += d[1];
+            at.StepY();
+        } else {
+            t2 += d[2];
+            at.StepZ();
+        }
+        at.Mark();
+    }
+    t[0] = t0, t[1] = t1, t[2] = t2;
+}
+
+// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel, then every voxel the walk enters
+// until it enters the end voxel or a voxel it would leave beyond the ray's length (OctoMap's
+// guard against rounding near the end: such a voxel is not marked). The exit distance of the
+// current voxel is the smallest tMax, which is the one the walk steps on, so the guard costs one
+// comparison per step. The box check bounds every write, whatever the rounding does; the box's
+// padding of one voxel holds every voxel the walk can enter, so it never cuts a ray short.
+//
+// The first `steps - 4` steps skip all three tests, because none can fire there
+// (docs/integration.md, "Speed"): step k takes the k-th smallest crossing time of the three
+// axes. At least steps - 3 crossings lie a whole voxel before the end voxel's entry (all but
+// the last along each axis), far more than the float rounding (~1e-7 of the length), so every
+// voxel entered by then is left before the length, no crossing beyond the end's slab is taken
+// (the walk stays inside the key box of origin and end), and the end, reachable only at step
+// `steps`, is not. With `words` (the dense bitmap `mark` sets bits in), those steps go through a
+// WordCursor.
+template <typename MarkFn>
+inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark, uint64_t* words) {
+    if (ray.start == ray.end) return;  // origin and end share a voxel: no free cells
+    // Locals, not members: the marks are stores the compiler cannot prove apart from `ray`, so
+    // values read through `ray` would be reloaded after every store.
+    int64_t pos = ray.start;
+    const int64_t end = ray.end;
+    const int64_t s0 = ray.stride[0], s1 = ray.stride[1], s2 = ray.stride[2];
+    const double d0 = ray.t_delta[0], d1 = ray.t_delta[1], d2 = ray.t_delta[2];
+    const double length = ray.length;
+    double t[3] = {ray.t_max[0], ray.t_max[1], ray.t_max[2]};
+    const double d[3] = {d0, d1, d2};
+    mark(pos);  // OctoMap adds the origin's key before any test
+    if (words != nullptr) {
+        WordCursor at{words, pos >> 6, uint64_t{1} << (pos & 63), s0 / 64, s1 / 64, s2 > 0};
+        StepsWithoutTests(ray.steps - 4, t, d, at);
+        pos = at.Pos();
+    } else {
+        PosCursor<MarkFn> at{pos, s0, s1, s2, mark};
+        StepsWithoutTests(ray.steps - 4, t, d, at);
+        pos = at.Pos();
+    }
+    double t0 = t[0], t1 = t[1], t2 = t[2];
+    for (;;) {
+        // The exit distance of voxel `pos` is the tMax the walk steps on: beyond the length, the
+        // voxel is not marked and the walk ends. (For the origin voxel, marked above, ending here
+        // gives OctoMap's set too: exit distances never decrease along the walk.)
+        if (t0 < t1) {
+            if (t0 < t2) {
+                if (t0 > length) return;
+                mark(pos);
+                t0 += d0;
+                pos += s0;
+            } else {
+                if (t2 > length) return;
+                mark(pos);
+                t2 += d2;
+                pos += s2;
+            }
+        } else if (t1 < t2) {
+            if (t1 > length) return;
+            mark(pos);
+            t1 += d1;
+            pos += s1;
+        } else {
+            if (t2 > length) return;
+            mark(pos);
+            t2 += d2;
+            pos += s2;
+        }
+        if (pos == end || static_cast<uint64_t>(pos) >= box_size) return;
+    }
+}
+
+// Traces the rays of points `range` (dropped points have none) in the scan's number type.
+template <typename MarkFn>
+void TraceRays(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, MarkFn&& mark,
+               uint64_t* words) {
+    const auto trace = [&](auto zero) {
+        const RayStarts<decltype(zero)> starts(scan);
+        const auto box_size = static_cast<uint64_t>(scan.box.size());
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            if (scan.kinds[i] != PointKind::kDropped) TraceRay(starts(i), box_size, mark, words);
+        }
+    };
+    scan.float_rays ? trace(0.0f) : trace(0.0);
+}
+
+}  // namespace strata::integration::detail
