@@ -35,20 +35,29 @@ void NearestOrigins::Find(const Eigen::Vector3d& p, size_t count,
     const Eigen::Vector2d q = (p.head<2>() - min_) / cell_m_;
     const int cx = static_cast<int>(std::floor(q.x())), cy = static_cast<int>(std::floor(q.y()));
     const int far = std::max({cx, cells_.x() - 1 - cx, cy, cells_.y() - 1 - cy});
-    for (int r = 0; r <= far; ++r) {
+    size_t seen = 0;  // origins looked at so far
+    for (int r = 0; r <= far && seen < origins_.size(); ++r) {
         // Origins in ring r are at least (r - 1) cells away in x or y; with ties kept: equal
         // distances are decided by index, as a full sort would.
         if (out.size() >= count) {
             const double reach = std::max(0, r - 1) * cell_m_;
             if (reach * reach > out[count - 1].first) break;
         }
-        for (int y = cy - r; y <= cy + r; ++y) {
-            for (int x = cx - r; x <= cx + r; ++x) {
-                if (std::max(std::abs(x - cx), std::abs(y - cy)) != r) continue;
-                if (x < 0 || y < 0 || x >= cells_.x() || y >= cells_.y()) continue;
-                for (size_t k : buckets_[static_cast<size_t>(y) * cells_.x() + x]) {
-                    out.emplace_back((p - origins_[k]).squaredNorm(), k);
-                }
+        const auto visit = [&](int x, int y) {
+            if (x < 0 || y < 0 || x >= cells_.x() || y >= cells_.y()) return;
+            for (size_t k : buckets_[static_cast<size_t>(y) * cells_.x() + x]) {
+                out.emplace_back((p - origins_[k]).squaredNorm(), k);
+                ++seen;
+            }
+        };
+        // The ring's cells inside the grid: its bottom and top rows whole, two cells between.
+        const int x0 = std::max(0, cx - r), x1 = std::min(cells_.x() - 1, cx + r);
+        for (int y = std::max(0, cy - r); y <= std::min(cells_.y() - 1, cy + r); ++y) {
+            if (std::abs(y - cy) == r) {
+                for (int x = x0; x <= x1; ++x) visit(x, y);
+            } else {
+                visit(cx - r, y);
+                visit(cx + r, y);
             }
         }
         std::sort(out.begin(), out.end());
