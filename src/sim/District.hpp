@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "SceneParse.hpp"
+#include "strata/sim/GroundTruth.hpp"
 
 namespace strata::sim::detail {
 
@@ -102,6 +103,13 @@ struct DistrictPlan {
 /// [x, y] as JSON.
 [[nodiscard]] inline nlohmann::json JsonXy(const Eigen::Vector2d& p) {
     return nlohmann::json::array({p.x(), p.y()});
+}
+
+/// A plant that can grow: its crown box seen from above.
+[[nodiscard]] inline DistrictPlan::Item PlantItem(const Segment& segment, const BoxTruth& crown) {
+    const Eigen::Vector2d half = 0.5 * crown.size.head<2>();
+    return {segment, crown.name, crown.center.head<2>() - half, crown.center.head<2>() + half,
+            false};
 }
 
 /// Reads and checks the block (sizes bounded so that no input generates without end).

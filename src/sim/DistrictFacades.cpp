@@ -50,21 +50,21 @@ public:
         // Step 1: each corner gets an adjoining wall (one arm on each side) or stays bare.
         const FacadeKind* adjoining = Kind("adjoining");
         for (int q = 0; q < 4; ++q) {
-            Side& before = sides_[(q + 3) % 4];
+            const int p = (q + 3) % 4;  // the side that ends at corner q
             const double u = rng_.Uniform();
-            const double arm_before = rng_.Uniform(0.0, 1.0);
-            const double arm_after = rng_.Uniform(0.0, 1.0);
+            const double arm_before = rng_.Uniform();
+            const double arm_after = rng_.Uniform();
             if (adjoining == nullptr || u >= c_.corners) {
-                start_[q] = end_[(q + 3) % 4] = kCornerMarginM;
+                start_[q] = end_[p] = kCornerMarginM;
                 continue;
             }
             const DistrictRange& len = adjoining->length;
             start_[q] =
                 std::min(len.lo + arm_after * (len.hi - len.lo), kArmShare * sides_[q].length);
-            end_[(q + 3) % 4] =
-                std::min(len.lo + arm_before * (len.hi - len.lo), kArmShare * before.length);
+            end_[p] =
+                std::min(len.lo + arm_before * (len.hi - len.lo), kArmShare * sides_[p].length);
             json w = Common(name_ + kCornerNames[q], "adjoining", *adjoining);
-            w["start"] = JsonXy(before.At(before.length - end_[(q + 3) % 4]));
+            w["start"] = JsonXy(sides_[p].At(sides_[p].length - end_[p]));
             w["corner"] = JsonXy(sides_[q].start);
             w["end"] = JsonXy(sides_[q].At(start_[q]));
             (void)AddDistrictItem(a_, "walls", w);
@@ -178,10 +178,7 @@ private:
         const json b = {{"name", name + "_bush"},
                         {"at", JsonXy(side.At(t + u) + kBushFromFacadeM * side.Front())},
                         {"radius", along_x ? json{rx, 0.6, 0.6} : json{0.6, rx, 0.6}}};
-        const BoxTruth box = ObjectBox(AddDistrictItem(a_, "bushes", b));
-        const Eigen::Vector2d half = 0.5 * box.size.head<2>();
-        plan_.bushes.push_back({side.faces, box.name, box.center.head<2>() - half,
-                                box.center.head<2>() + half, false});
+        plan_.bushes.push_back(PlantItem(side.faces, ObjectBox(AddDistrictItem(a_, "bushes", b))));
     }
 
     const DistrictConfig& c_;

@@ -95,10 +95,7 @@ void AddDistrictSidewalk(const DistrictConfig& c, const Segment& seg, const Segm
                            {"at", JsonXy(f.At(t + jitter, kerb + side * kTreeFromKerbM))},
                            {"height", height},
                            {"crown_radius", radius}};
-        const BoxTruth box = ObjectBox(AddDistrictItem(a, "trees", tree));
-        const Eigen::Vector2d half = 0.5 * box.size.head<2>();
-        plan.trees.push_back(
-            {seg, box.name, box.center.head<2>() - half, box.center.head<2>() + half, false});
+        plan.trees.push_back(PlantItem(seg, ObjectBox(AddDistrictItem(a, "trees", tree))));
     }
     const auto every = std::max<long>(1, std::lround(c.pole_spacing / c.tree_spacing));
     for (long k = every; k * c.tree_spacing < f.length - 1.0; k += every) {

@@ -2,6 +2,8 @@
 #include <cmath>
 
 #include "District.hpp"
+#include "ObjectGeometry.hpp"
+#include "strata/core/Error.hpp"
 
 // Reading the "district" block (docs/simulator.md, "Districts"). Every size is bounded: the scene
 // parser is fuzzed, and a district must never generate without end or exhaust memory.
@@ -14,29 +16,16 @@ constexpr int kMaxEditsPerKind = 200;   // per session
 constexpr double kMaxObjects = 60000;   // estimated before generating (ids stop at 65535)
 constexpr double kMaxFacadeArea = 4e6;  // m^2, bounds the window openings
 
-double Within(JsonReader& r, const std::string& key, double fallback, double lo, double hi) {
-    const double v = r.Get<double>(key, fallback);
-    if (!(v >= lo && v <= hi)) {
-        r.Fail("'" + key + "' must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    }
-    return v;
-}
-
 int IntWithin(JsonReader& r, const std::string& key, int fallback, int lo, int hi) {
-    const double v = Within(r, key, fallback, lo, hi);  // read as a number: no int overflow
+    const double v = r.Within(key, fallback, lo, hi);  // read as a number: no int overflow
     if (v != std::floor(v)) r.Fail("'" + key + "' must be a whole number");
     return static_cast<int>(v);
 }
 
 DistrictRange RangeWithin(JsonReader& r, const std::string& key, DistrictRange fallback, double lo,
                           double hi) {
-    if (!r.Has(key)) return fallback;
-    const auto v = r.Require<std::vector<double>>(key);
-    if (v.size() != 2 || !(v[0] >= lo && v[0] <= v[1] && v[1] <= hi)) {
-        r.Fail("'" + key + "' must be [min, max] within [" + std::to_string(lo) + ", " +
-               std::to_string(hi) + "]");
-    }
-    return {v[0], v[1]};
+    const auto [min, max] = r.Interval(key, {fallback.lo, fallback.hi}, lo, hi);
+    return {min, max};
 }
 
 Eigen::Vector2i BlockPair(JsonReader& r, const std::vector<double>& v, int hi_x, int hi_y) {
@@ -57,10 +46,10 @@ std::vector<FacadeKind> DefaultKinds() {
 
 void ReadFacades(JsonReader& r, DistrictConfig& c) {
     c.height = RangeWithin(r, "height", c.height, 2.5, 40.0);
-    c.thickness = Within(r, "thickness", c.thickness, 0.1, 1.0);
+    c.thickness = r.Within("thickness", c.thickness, 0.1, 1.0);
     c.gap = RangeWithin(r, "gap", c.gap, 1.5, 50.0);
-    c.windows = Within(r, "windows", c.windows, 0.0, 1.0);
-    c.corners = Within(r, "corners", c.corners, 0.0, 1.0);
+    c.windows = r.Within("windows", c.windows, 0.0, 1.0);
+    c.corners = r.Within("corners", c.corners, 0.0, 1.0);
     if (!r.Has("kinds")) return;
     c.kinds.clear();
     for (JsonReader& k : r.Items("kinds")) {
@@ -73,7 +62,7 @@ void ReadFacades(JsonReader& r, DistrictConfig& c) {
                    "' (flat, curved_edge, half_curved, sliding_door, adjoining)");
         }
         FacadeKind f = *known;
-        f.weight = Within(k, "weight", f.weight, 0.0, 1000.0);
+        f.weight = k.Within("weight", f.weight, 0.0, 1000.0);
         f.length = RangeWithin(k, "length", f.length, f.kind == "sliding_door" ? 10.0 : 4.0, 80.0);
         f.slant_deg = k.Get<std::vector<double>>("slant_deg", f.slant_deg);
         for (double s : f.slant_deg) {
@@ -139,10 +128,12 @@ DistrictConfig ReadDistrict(JsonReader& r) {
         c.blocks = BlockPair(r, r.Require<std::vector<double>>("blocks"), kMaxBlocks, kMaxBlocks);
     }
     if ((c.blocks.array() < 1).any()) r.Fail("'blocks' must be at least [1, 1]");
-    const DistrictRange size = RangeWithin(r, "block_size", {100.0, 100.0}, 30.0, 300.0);
-    c.block_size = {size.lo, size.hi};
-    c.street_width = Within(r, "street_width", c.street_width, 8.0, 60.0);
-    c.sidewalk = Within(r, "sidewalk", c.sidewalk, 2.0, 10.0);
+    if (r.Has("block_size")) c.block_size = r.Vec2("block_size");
+    if (!(c.block_size.minCoeff() >= 30.0 && c.block_size.maxCoeff() <= 300.0)) {
+        r.Fail("'block_size' must be [x, y] within [30, 300] m");
+    }
+    c.street_width = r.Within("street_width", c.street_width, 8.0, 60.0);
+    c.sidewalk = r.Within("sidewalk", c.sidewalk, 2.0, 10.0);
     if (c.block_size.minCoeff() - 2.0 * c.sidewalk < 20.0) {
         r.Fail("blocks need at least 20 m between their facade lines");
     }
@@ -153,8 +144,8 @@ DistrictConfig ReadDistrict(JsonReader& r) {
     }
     if (r.Has("parked_cars")) {
         JsonReader p = r.Child("parked_cars");
-        c.car_spacing = Within(p, "spacing", c.car_spacing, 6.0, 50.0);
-        c.car_end_margin = Within(p, "end_margin", c.car_end_margin, 0.0, 50.0);
+        c.car_spacing = p.Within("spacing", c.car_spacing, 6.0, 50.0);
+        c.car_end_margin = p.Within("end_margin", c.car_end_margin, 0.0, 50.0);
         c.car_types = p.Get<std::vector<std::string>>("types", c.car_types);
         for (const char* key : {"fill", "yaw_jitter_deg"}) {
             if (p.Has(key)) c.car_keys[key] = p.Raw(key);
@@ -162,26 +153,33 @@ DistrictConfig ReadDistrict(JsonReader& r) {
         p.Finish();
     }
     if (c.car_types.empty()) r.Fail("'parked_cars.types' needs at least one type");
+    for (const std::string& type : c.car_types) {
+        try {
+            (void)VehicleTypeOf(type);
+        } catch (const InvalidArgumentError& e) {
+            r.Fail(std::string("'parked_cars.types': ") + e.what());
+        }
+    }
     if (r.Has("trees")) {
         JsonReader t = r.Child("trees");
-        c.tree_spacing = Within(t, "spacing", c.tree_spacing, 4.0, 500.0);
-        c.tree_fill = Within(t, "fill", c.tree_fill, 0.0, 1.0);
+        c.tree_spacing = t.Within("spacing", c.tree_spacing, 4.0, 500.0);
+        c.tree_fill = t.Within("fill", c.tree_fill, 0.0, 1.0);
         c.tree_height = RangeWithin(t, "height", c.tree_height, 3.0, 30.0);
         c.crown_radius = RangeWithin(t, "crown_radius", c.crown_radius, 0.3, 1.8);
         t.Finish();
     }
-    c.bushes = Within(r, "bushes", c.bushes, 0.0, 1.0);
-    c.pole_spacing = Within(r, "pole_spacing", c.pole_spacing, 5.0, 1000.0);
+    c.bushes = r.Within("bushes", c.bushes, 0.0, 1.0);
+    c.pole_spacing = r.Within("pole_spacing", c.pole_spacing, 5.0, 1000.0);
     if (r.Has("drive")) {
         JsonReader d = r.Child("drive");
-        c.speed = Within(d, "speed", c.speed, 0.5, 50.0);
+        c.speed = d.Within("speed", c.speed, 0.5, 50.0);
         c.every = IntWithin(d, "every", c.every, 1, 1000);
-        c.sensor_height = Within(d, "height", c.sensor_height, 0.2, 5.0);
+        c.sensor_height = d.Within("height", c.sensor_height, 0.2, 5.0);
         const double half = 0.5 * c.street_width - 1.0;
-        c.lane_offset = Within(d, "lane_offset", c.lane_offset, -half, half);
+        c.lane_offset = d.Within("lane_offset", c.lane_offset, -half, half);
         d.Finish();
     }
-    c.edits_across = Within(r, "edits_across", c.edits_across, 0.0, 1e4);
+    c.edits_across = r.Within("edits_across", c.edits_across, 0.0, 1e4);
     std::vector<JsonReader> sessions = r.Items("sessions");
     if (sessions.size() > static_cast<size_t>(kMaxSessions)) r.Fail("at most 8 sessions");
     for (size_t k = 0; k < sessions.size(); ++k) {

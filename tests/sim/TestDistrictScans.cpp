@@ -100,7 +100,7 @@ TEST(District, BadBlocksNameTheFileAndTheProblem) {
         {R"({"blocks": [0, 2]})", "district: 'blocks' must be at least [1, 1]"},
         {R"({"blocks": [2.5, 2]})", "district: block indices must be whole numbers"},
         {R"({"blocks": [99, 2]})", "district: block indices must be whole numbers [i, j] within"},
-        {R"({"block_size": [100, 1e300]})", "district: 'block_size' must be [min, max] within"},
+        {R"({"block_size": [100, 1e300]})", "district: 'block_size' must be [x, y] within [30, 300] m"},
         {R"({"sidewalk": 9, "block_size": [30, 30]})", "at least 20 m between their facade lines"},
         {R"({"facades": {"kinds": [{"kind": "gothic"}]}})", "unknown facade kind 'gothic'"},
         {R"({"facades": {"kinds": [{"kind": "flat", "slant_deg": [120]}]}})",
@@ -113,6 +113,8 @@ TEST(District, BadBlocksNameTheFileAndTheProblem) {
         {R"({"blocks": [16, 16], "block_size": [300, 300], "trees": {"spacing": 4}})",
          "is too large"},
         {R"({"drive": {"every": 1e30}})", "district.drive: 'every' must be in"},
+        {R"({"parked_cars": {"types": ["tank"]}})", "'parked_cars.types': unknown vehicle type"},
+        {R"({"parked_cars": {"fill": "most"}})", "'fill' has the wrong type"},
         {R"({"colour": "red"})", "district: unknown key 'colour'"}};
     for (const auto& [input, expected] : cases) {
         const std::string what = DistrictError(input);
