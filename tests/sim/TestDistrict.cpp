@@ -127,7 +127,7 @@ TEST(District, WallsCarsAndEditsStraddleEveryTileBorder) {
     }
     size_t straddling_edits = 0;
     for (const auto& [border, names] : edits) straddling_edits += names.size();
-    EXPECT_GE(straddling_edits, 1U);
+    EXPECT_GE(straddling_edits, 5U) << "measured 10";
 }
 
 }  // namespace strata::sim

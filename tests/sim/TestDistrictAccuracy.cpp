@@ -70,16 +70,25 @@ const District& Small() {
         (void)sim::SimulateSceneToSequence(spec, temp / "sim", config);
         const auto dir = [&](size_t s) { return temp / "sim" / ("session_" + std::to_string(s)); };
 
+        // The edited objects of every session, whose points the change scoring needs.
+        std::vector<std::vector<testing::TruthEdit>> edits;
+        std::set<int> edited;
+        for (size_t s = 0; s < spec.sessions.size(); ++s) {
+            edits.push_back(testing::ReadTruthEdits(dir(s) / "ground_truth.json"));
+            for (const testing::TruthEdit& e : edits.back()) edited.insert(e.object);
+        }
         store::StoreSettings settings;
         settings.voxel_size_m = kVoxel;
         store::MapStore map = store::MapStore::Create(temp / "map", settings);
         std::vector<int64_t> ids;
+        std::vector<testing::SessionHits> hits(spec.sessions.size());
         for (size_t s = 0; s < spec.sessions.size(); ++s) {
             const io::KittiSequence seq = io::OpenKittiSequence(dir(s));
             store::SessionWriter writer(map, integration::IntegrationConfig{}, {});
             for (size_t i = 0; i < seq.size(); ++i) {
                 const core::Scan scan = io::ReadKittiScan(seq, i);
                 if (s == 0) d.origins.push_back(scan.T_world_sensor.translation());
+                testing::AddSessionHits(hits[s], scan, edited, kVoxel);
                 writer.Integrate(scan);
             }
             ids.push_back(writer.Commit().id);
@@ -92,11 +101,9 @@ const District& Small() {
         for (size_t k = 1; k < ids.size(); ++k) {
             testing::ChangeCase c;
             c.voxel = kVoxel;
-            c.edits = testing::ReadTruthEdits(dir(k) / "ground_truth.json");
-            std::set<int> objects;
-            for (const testing::TruthEdit& e : c.edits) objects.insert(e.object);
-            c.hits_a = testing::ReadSessionHits(io::OpenKittiSequence(dir(k - 1)), objects, kVoxel);
-            c.hits_b = testing::ReadSessionHits(io::OpenKittiSequence(dir(k)), objects, kVoxel);
+            c.edits = edits[k];
+            c.hits_a = hits[k - 1];
+            c.hits_b = hits[k];
             c.a = observer.Session(ids[k - 1]);
             c.b = observer.Session(ids[k]);
             d.changes.push_back(std::move(c));

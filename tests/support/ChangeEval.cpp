@@ -77,18 +77,22 @@ std::vector<TruthEdit> ReadTruthEdits(const std::filesystem::path& ground_truth)
     return edits;
 }
 
+void AddSessionHits(SessionHits& hits, const core::Scan& scan, const std::set<int>& objects,
+                    double voxel) {
+    auto acc = hits.all->getAccessor();
+    for (size_t p = 0; p < scan.points.size(); ++p) {
+        const Eigen::Vector3d w = scan.T_world_sensor * scan.points[p];
+        acc.setValueOn(VoxelOf(w, voxel), true);
+        const int id = scan.instances.empty() ? 0 : scan.instances[p];
+        if (objects.count(id)) hits.by_object[id].push_back(w);
+    }
+}
+
 SessionHits ReadSessionHits(const io::KittiSequence& seq, const std::set<int>& objects,
                             double voxel) {
     SessionHits hits;
-    auto acc = hits.all->getAccessor();
     for (size_t i = 0; i < seq.size(); ++i) {
-        const core::Scan scan = io::ReadKittiScan(seq, i);
-        for (size_t p = 0; p < scan.points.size(); ++p) {
-            const Eigen::Vector3d w = scan.T_world_sensor * scan.points[p];
-            acc.setValueOn(VoxelOf(w, voxel), true);
-            const int id = scan.instances.empty() ? 0 : scan.instances[p];
-            if (objects.count(id)) hits.by_object[id].push_back(w);
-        }
+        AddSessionHits(hits, io::ReadKittiScan(seq, i), objects, voxel);
     }
     return hits;
 }

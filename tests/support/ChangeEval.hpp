@@ -37,6 +37,9 @@ struct SessionHits {
 };
 [[nodiscard]] SessionHits ReadSessionHits(const io::KittiSequence& seq,
                                           const std::set<int>& objects, double voxel);
+/// Adds one scan's points to `hits` (ReadSessionHits one scan at a time).
+void AddSessionHits(SessionHits& hits, const core::Scan& scan, const std::set<int>& objects,
+                    double voxel);
 
 /// Two sessions of a simulated scene, as the map store saw them, and the edits between them.
 struct ChangeCase {
