@@ -107,10 +107,10 @@ int main(int argc, char** argv) {
         Shell("git -C " + std::string(STRATA_SOURCE_DIR) + " rev-parse --short HEAD").c_str(),
         Shell("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'").c_str(),
         std::thread::hardware_concurrency(), Shell("uptime").c_str());
-    // Step 1: simulate every session.
-    const Run sim = Execute(
-        {strata, "simulate", "--scene", scene.string(), "--out", (work / "sim").string(), "--json"},
-        work / "simulate.json");
+    // Step 1: simulate every session (pictures at 1 m: a 990 px overview of the district).
+    const Run sim = Execute({strata, "simulate", "--scene", scene.string(), "--out",
+                             (work / "sim").string(), "--picture-pixel", "1", "--json"},
+                            work / "simulate.json");
     std::ifstream sim_in(work / "simulate.json");
     const nlohmann::json report = nlohmann::json::parse(sim_in);
     const double sim_mb = Megabytes(work / "sim");

@@ -20,18 +20,6 @@ constexpr double kTreeFromKerbM = 1.5;
 constexpr double kLightFromKerbM = 0.5;
 constexpr double kLightHeightM = 7.0;
 
-Eigen::AlignedBox2d Footprint(const BoxTruth& b) {
-    const double yaw = DegToRad(b.yaw_deg);
-    const Eigen::Vector2d u(std::cos(yaw), std::sin(yaw)), v(-u.y(), u.x());
-    Eigen::AlignedBox2d box;
-    for (const double su : {-0.5, 0.5}) {
-        for (const double sv : {-0.5, 0.5}) {
-            box.extend(b.center.head<2>() + su * b.size.x() * u + sv * b.size.y() * v);
-        }
-    }
-    return box;
-}
-
 }  // namespace
 
 // One kerb: a parked_cars line (read by the scene file's own parser), then its slots.
@@ -69,7 +57,8 @@ void AddDistrictKerb(const DistrictConfig& c, const Segment& seg, const SegmentF
         nominal.center << p.at, 0.0;
         nominal.size = VehicleTypeOf("car").size;
         nominal.yaw_deg = yaw_deg;
-        p.box = Footprint(it == parked.end() ? nominal : ObjectBox(a.spec().objects[it->second]));
+        p.box =
+            (it == parked.end() ? nominal : ObjectBox(a.spec().objects[it->second])).Footprint();
         if (it != parked.end()) p.occupant = it->first;
         plan.slots.push_back(p);
     }

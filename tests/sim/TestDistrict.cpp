@@ -21,19 +21,6 @@ const double kBorders[] = {64.0, 128.0};  // inside the small district, along x 
 
 SceneSpec Small() { return LoadSceneSpec(test::ExampleScene("district_small")); }
 
-// An oriented box of the ground truth, seen from above.
-Eigen::AlignedBox2d Footprint(const BoxTruth& b) {
-    const double yaw = b.yaw_deg * M_PI / 180.0;
-    const Eigen::Vector2d u(std::cos(yaw), std::sin(yaw)), v(-u.y(), u.x());
-    Eigen::AlignedBox2d box;
-    for (const double su : {-0.5, 0.5}) {
-        for (const double sv : {-0.5, 0.5}) {
-            box.extend(b.center.head<2>() + su * b.size.x() * u + sv * b.size.y() * v);
-        }
-    }
-    return box;
-}
-
 // "x=64", "y=128", ...: the tile borders a footprint crosses.
 std::set<std::string> BordersCrossed(const Eigen::AlignedBox2d& box) {
     std::set<std::string> crossed;
@@ -102,10 +89,10 @@ TEST(District, WallsCarsAndEditsStraddleEveryTileBorder) {
             for (const std::string& b : BordersCrossed(WallFootprint(w))) walls[b].insert(w.name);
         }
         for (const BoxTruth& v : scene.truth.vehicles) {
-            for (const std::string& b : BordersCrossed(Footprint(v))) cars[b].insert(v.name);
+            for (const std::string& b : BordersCrossed(v.Footprint())) cars[b].insert(v.name);
         }
         for (const EditTruth& e : scene.truth.edits) {
-            for (const std::string& b : BordersCrossed(Footprint(e.box))) {
+            for (const std::string& b : BordersCrossed(e.box.Footprint())) {
                 edits[b].insert(e.box.name + " (" + e.kind + ", " + spec.sessions[s].name + ")");
             }
         }
