@@ -25,16 +25,16 @@ constexpr double kVoxel = 0.2;  // the store's default, as the district is integ
 // Bounds at about 2x what this scene measured (2026-12-02: walls 42 of 43 found, slant error
 // mean 0.051 deg, max 0.215 deg, 1 of 39 vegetation parts taken for a wall; vehicles from labels
 // 120 of 120 boxes, 0 false, mean IoU 0.962; geometric 100 of 120, 35 false, 0.838; changes
-// 9 and 8 edits, precision and recall 1, IoU 0.932 and 0.946) and never looser than the targets
-// the street, the garage and the two-session street are held to.
+// 9 and 8 edits, precision and recall 1, IoU 0.932 and 0.946), within the targets the street,
+// the garage and the two-session street are held to, but for the geometric vehicle detector.
 // One wall's front (b1_1_n1) hides behind the vans at its kerb; the analysis finds only its
 // back face, seen across the courtyard, 0.35 m off the front polygon.
 constexpr double kMinWallsFound = 0.95;
 constexpr double kMaxMeanSlantErrorDeg = 0.12;  // the street's bound at 0.2 m
 constexpr double kMaxSlantErrorDeg = 0.45;
-constexpr size_t kMaxVegetationAsWall = 2;
-constexpr double kMinMatchedFraction = 0.9;  // the garage's, labels
-constexpr size_t kMaxFalseVehicles = 2;      // the garage's, labels
+constexpr double kMaxVegetationAsWall = 0.05;  // of the vegetation parts: the street's target
+constexpr double kMinMatchedFraction = 0.9;    // the garage's, labels
+constexpr size_t kMaxFalseVehicles = 2;        // the garage's, labels
 constexpr double kMinMeanIoU = 0.9;
 // The geometric detector takes facades seen only below 2.3 m (all a car's sensor sees of them
 // near by) and bushes for cars: far more false boxes than in the garage, whose walls reach the
@@ -128,7 +128,7 @@ TEST(DistrictAccuracy, WallSlantsAsOnTheStreet) {
     EXPECT_GE(s.found, kMinWallsFound * static_cast<double>(s.counted));
     EXPECT_LE(s.mean_error, kMaxMeanSlantErrorDeg);
     EXPECT_LE(s.max_error, kMaxSlantErrorDeg);
-    EXPECT_LE(s.vegetation_as_wall, kMaxVegetationAsWall);
+    EXPECT_LE(s.vegetation_as_wall, kMaxVegetationAsWall * static_cast<double>(s.vegetation));
     EXPECT_GE(s.vegetation, 10U) << "the district's trees and bushes are looked at";
 }
 
