@@ -113,12 +113,7 @@ const District& Small() {
     return district;
 }
 
-}  // namespace
-
-TEST(DistrictAccuracy, TheMapHoldsNineTilesOf64m) { EXPECT_EQ(Small().tiles, 9U); }
-
-TEST(DistrictAccuracy, WallSlantsAsOnTheStreet) {
-    const District& d = Small();
+void ExpectWallSlantsAsOnTheStreet(const District& d) {
     const walls::WallResult result = walls::FindWalls(d.survey);
     const testing::WallScore s = testing::ScoreWalls(d.walls, d.survey, result, true);
     std::printf(
@@ -132,8 +127,7 @@ TEST(DistrictAccuracy, WallSlantsAsOnTheStreet) {
     EXPECT_GE(s.vegetation, 10U) << "the district's trees and bushes are looked at";
 }
 
-TEST(DistrictAccuracy, VehicleBoxesAsInTheGarage) {
-    const District& d = Small();
+void ExpectVehicleBoxesAsInTheGarage(const District& d) {
     testing::ParkingCase c{d.survey.DeepCopy(), d.survey.DeepCopy(), d.scene, d.origins, {}};
     c.unlabelled.label->clear();
     c.unlabelled.label_weight->clear();
@@ -162,8 +156,8 @@ TEST(DistrictAccuracy, VehicleBoxesAsInTheGarage) {
     }
 }
 
-TEST(DistrictAccuracy, ChangesAsOnTheTwoSessionStreet) {
-    for (const testing::ChangeCase& c : Small().changes) {
+void ExpectChangesAsOnTheTwoSessionStreet(const District& d) {
+    for (const testing::ChangeCase& c : d.changes) {
         const testing::ChangeScore s = testing::ScoreChanges(c, change::ChangeQuery{}, false, true);
         const testing::ChangeScore strict =
             testing::ScoreChanges(c, change::ChangeQuery{}, true, false);
@@ -176,6 +170,26 @@ TEST(DistrictAccuracy, ChangesAsOnTheTwoSessionStreet) {
         EXPECT_GE(s.recall, kMinRecall);
         EXPECT_GE(s.iou, kMinIoU);
         EXPECT_GE(strict.iou, kMinIoU);
+    }
+}
+
+}  // namespace
+
+// One test: a process simulates and integrates the small district once (about half a minute).
+TEST(DistrictAccuracy, WholeMapScoresAsTheExampleScenes) {
+    const District& d = Small();
+    EXPECT_EQ(d.tiles, 9U);
+    {
+        SCOPED_TRACE("walls");
+        ExpectWallSlantsAsOnTheStreet(d);
+    }
+    {
+        SCOPED_TRACE("vehicles");
+        ExpectVehicleBoxesAsInTheGarage(d);
+    }
+    {
+        SCOPED_TRACE("changes");
+        ExpectChangesAsOnTheTwoSessionStreet(d);
     }
 }
 
