@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "strata/sim/GroundTruth.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/sim/GroundTruth.hpp"
 
 namespace strata::sim {
 namespace {
@@ -56,6 +56,18 @@ private:
 };
 
 }  // namespace
+
+Eigen::AlignedBox2d BoxTruth::Footprint() const {
+    const double yaw = yaw_deg * M_PI / 180.0;
+    const Eigen::Vector2d u(std::cos(yaw), std::sin(yaw)), v(-u.y(), u.x());
+    Eigen::AlignedBox2d box;
+    for (const double su : {-0.5, 0.5}) {
+        for (const double sv : {-0.5, 0.5}) {
+            box.extend(center.head<2>() + su * size.x() * u + sv * size.y() * v);
+        }
+    }
+    return box;
+}
 
 void WriteGroundTruth(const std::filesystem::path& path, const GroundTruth& truth) {
     const ToSession to(truth.T_world_session);

@@ -8,6 +8,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace strata::sim::detail {
@@ -35,6 +36,23 @@ public:
     [[nodiscard]] T Require(const std::string& key) {
         if (!Has(key)) Fail("missing key '" + key + "'");
         return Convert<T>(key);
+    }
+    /// A number in [lo, hi]; out of range (NaN, infinite) is an error naming the key.
+    [[nodiscard]] double Within(const std::string& key, double fallback, double lo, double hi) {
+        const double v = Get<double>(key, fallback);
+        if (!(v >= lo && v <= hi)) Fail("'" + key + "' must be in " + Bounds(lo, hi));
+        return v;
+    }
+    /// [min, max] with lo <= min <= max <= hi.
+    [[nodiscard]] std::pair<double, double> Interval(const std::string& key,
+                                                     std::pair<double, double> fallback, double lo,
+                                                     double hi) {
+        if (!Has(key)) return fallback;
+        const auto v = Require<std::vector<double>>(key);
+        if (v.size() != 2 || !(v[0] >= lo && v[0] <= v[1] && v[1] <= hi)) {
+            Fail("'" + key + "' must be [min, max] within " + Bounds(lo, hi));
+        }
+        return {v[0], v[1]};
     }
     /// [x, y] (or the first two of [x, y, z]).
     [[nodiscard]] Eigen::Vector2d Vec2(const std::string& key) {
@@ -82,6 +100,9 @@ private:
         } catch (const nlohmann::json::exception&) {
             Fail("'" + key + "' has the wrong type");
         }
+    }
+    [[nodiscard]] static std::string Bounds(double lo, double hi) {
+        return "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
     }
     [[nodiscard]] std::string Sub(const std::string& key) const {
         return path_.empty() ? key : path_ + "." + key;

@@ -41,6 +41,8 @@ void AddWindowGrid(JsonReader& r, WallSpec& wall);
 void ParseParkedCars(JsonReader& r, SceneAssembler& a);
 void GenerateParkingGarage(JsonReader& r, SceneAssembler& a);
 void GenerateBuilding(JsonReader& r, SceneAssembler& a);
+/// A grid of streets with its sessions (District.hpp).
+void GenerateDistrict(JsonReader& r, SceneAssembler& a);
 
 [[nodiscard]] TrajectorySpec ParseTrajectory(JsonReader& r);
 [[nodiscard]] SessionSpec ParseSession(JsonReader& r, const TrajectorySpec& fallback,

@@ -1,5 +1,4 @@
 #include "strata/sim/SceneSpec.hpp"
-#include "strata/core/Error.hpp"
 
 #include <fstream>
 #include <limits>
@@ -8,6 +7,7 @@
 
 #include "ObjectGeometry.hpp"
 #include "SceneParse.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/KittiIds.hpp"
 
 namespace strata::sim {
@@ -77,6 +77,10 @@ SceneSpec ParseJson(const json& root, const std::string& source) {
     spec.name = r.Get<std::string>("name", "scene");
     spec.seed = r.Get<uint64_t>("seed", 1);
     spec.sensor = r.Get<std::string>("sensor", "hdl64");
+    spec.surface_spacing_m = r.Get<double>("surface_spacing", spec.surface_spacing_m);
+    if (!(spec.surface_spacing_m >= 0.01 && spec.surface_spacing_m <= 10.0)) {
+        r.Fail("'surface_spacing' must be in [0.01, 10] m");
+    }
     (void)r.Has("description");  // free text for people
     detail::SceneAssembler a(spec);
     // Generators first (they lay the ground the other objects stand on), then object lists.
@@ -87,6 +91,13 @@ SceneSpec ParseJson(const json& root, const std::string& source) {
     if (r.Has("building")) {
         detail::JsonReader g = r.Child("building");
         detail::GenerateBuilding(g, a);
+    }
+    if (r.Has("district")) {
+        if (r.Has("sessions") || r.Has("trajectory")) {
+            r.Fail("a 'district' drives its own sessions: no 'sessions' or 'trajectory' beside it");
+        }
+        detail::JsonReader g = r.Child("district");
+        detail::GenerateDistrict(g, a);
     }
     const std::pair<const char*, const char*> kinds[] = {
         {"ground", "ground"}, {"walls", "wall"}, {"vehicles", "vehicle"}, {"trees", "tree"},
@@ -140,7 +151,7 @@ void SceneSpec::Validate() const {
     for (size_t s = 0; s < sessions.size(); ++s) {
         if (sessions[s].trajectory.waypoints.empty()) {
             throw FormatError(source + ": session '" + sessions[s].name +
-                                        "' has no trajectory waypoints");
+                              "' has no trajectory waypoints");
         }
         (void)ObjectsOfSession(*this, s);  // throws on an edit of an unknown object
     }

@@ -1,10 +1,10 @@
 #include "strata/sim/SimulateScene.hpp"
-#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/sim/SequenceWriter.hpp"
 #include "strata/sim/Simulator.hpp"
 #include "strata/sim/StaticSurface.hpp"
@@ -72,7 +72,9 @@ SessionReport SimulateSession(const SceneSpec& spec, size_t s, const std::filesy
     writer.Finish();
     report.scans = writer.scans();
     // Ground truth: the static surface sample, then ground_truth.json beside the scans.
-    SurfaceSample surface = SampleStaticSurface(scene, config.surface_spacing_m, spec.seed);
+    report.surface_spacing_m =
+        config.surface_spacing_m > 0.0 ? config.surface_spacing_m : spec.surface_spacing_m;
+    SurfaceSample surface = SampleStaticSurface(scene, report.surface_spacing_m, spec.seed);
     if (config.mark_observed) {
         std::vector<Eigen::Vector3d> origins;
         for (const ScanPose& p : poses) origins.push_back(p.T_world_sensor.translation());
@@ -106,8 +108,8 @@ void SimulateConfig::Validate() const {
     if (range_noise_m && !(*range_noise_m >= 0.0)) {
         throw InvalidArgumentError("range noise must be >= 0");
     }
-    if (!(surface_spacing_m >= 0.01)) {
-        throw InvalidArgumentError("surface spacing must be at least 0.01 m");
+    if (!(surface_spacing_m == 0.0 || surface_spacing_m >= 0.01)) {
+        throw InvalidArgumentError("surface spacing must be 0 (the scene's) or at least 0.01 m");
     }
     picture.Validate();
 }

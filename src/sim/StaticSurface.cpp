@@ -1,5 +1,4 @@
 #include "strata/sim/StaticSurface.hpp"
-#include "strata/core/Error.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,7 +8,9 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "NearestOrigins.hpp"
 #include "Rng.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/Simulator.hpp"
 
 namespace strata::sim {
@@ -18,6 +19,8 @@ namespace {
 // A point hidden from its nearest scan positions is taken as unobserved (bounds the cost where
 // most of the surface is hidden, as indoors).
 constexpr size_t kOriginsTried = 8;
+// Buckets of scan positions for the nearest-origin search (any size gives the same answer).
+constexpr double kOriginCellM = 20.0;
 
 }  // namespace
 
@@ -56,33 +59,29 @@ void MarkObserved(SurfaceSample& sample, const Simulator& simulator,
     const double sin_min = std::sin(min_elevation_deg * M_PI / 180.0);
     const double sin_max = std::sin(max_elevation_deg * M_PI / 180.0);
     sample.observed.assign(sample.points.size(), 0);
+    const detail::NearestOrigins nearest(origins_world, kOriginCellM);
     // Range: points; each point tries its nearest origins and stops at the first that sees it.
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, sample.points.size(), 1024),
-        [&](const tbb::blocked_range<size_t>& r) {
-            std::vector<std::pair<double, size_t>> by_distance(origins_world.size());
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                for (size_t k = 0; k < origins_world.size(); ++k) {
-                    by_distance[k] = {(sample.points[i] - origins_world[k]).squaredNorm(), k};
-                }
-                const size_t tries = std::min(kOriginsTried, by_distance.size());
-                std::partial_sort(by_distance.begin(), by_distance.begin() + tries,
-                                  by_distance.end());
-                for (size_t k = 0; k < tries; ++k) {
-                    const Eigen::Vector3d& o = origins_world[by_distance[k].second];
-                    const Eigen::Vector3d d = sample.points[i] - o;
-                    const double dist = d.norm();
-                    if (dist > max_range_m || dist < 1e-6) break;
-                    const double sin_elevation = d.z() / dist;
-                    if (sin_elevation < sin_min || sin_elevation > sin_max) continue;
-                    // Stop just short of the point: it lies on its own surface.
-                    if (!simulator.CastRay(o, d, dist - 0.02)) {
-                        sample.observed[i] = 1;
-                        break;
-                    }
-                }
-            }
-        });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sample.points.size(), 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          std::vector<std::pair<double, size_t>> by_distance;
+                          for (size_t i = r.begin(); i != r.end(); ++i) {
+                              nearest.Find(sample.points[i], kOriginsTried, by_distance);
+                              const size_t tries = by_distance.size();
+                              for (size_t k = 0; k < tries; ++k) {
+                                  const Eigen::Vector3d& o = origins_world[by_distance[k].second];
+                                  const Eigen::Vector3d d = sample.points[i] - o;
+                                  const double dist = d.norm();
+                                  if (dist > max_range_m || dist < 1e-6) break;
+                                  const double sin_elevation = d.z() / dist;
+                                  if (sin_elevation < sin_min || sin_elevation > sin_max) continue;
+                                  // Stop just short of the point: it lies on its own surface.
+                                  if (!simulator.CastRay(o, d, dist - 0.02)) {
+                                      sample.observed[i] = 1;
+                                      break;
+                                  }
+                              }
+                          }
+                      });
 }
 
 void WriteSurfacePly(const std::filesystem::path& path, const SurfaceSample& sample,

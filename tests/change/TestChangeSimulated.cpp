@@ -5,11 +5,9 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <fstream>
-#include <map>
-#include <nlohmann/json.hpp>
 #include <set>
 
+#include "ChangeEval.hpp"
 #include "TempPath.hpp"
 #include "strata/change/ChangeDetection.hpp"
 #include "strata/change/MapObserver.hpp"
@@ -22,110 +20,44 @@ namespace {
 
 namespace fs = std::filesystem;
 using openvdb::BoolGrid;
-using openvdb::Coord;
 
 constexpr double kVoxel = 0.2;
 // The targets.
 constexpr double kMinPrecision = 0.95;
 constexpr double kMinRecall = 0.95;
 constexpr double kMinIoU = 0.9;
-// Points of an edited object count for it when inside its box grown by this much (range noise).
-constexpr double kBoxMargin = 0.3;
-// An edit is observable when at least this many of its voxels could be seen as changed.
-constexpr size_t kMinObservableVoxels = 8;
 
-struct Edit {
-    int object = 0;
-    std::string name, change, kind;
-    Eigen::Vector3d center, size;
-    double yaw_deg = 0.0;
-
-    [[nodiscard]] bool Contains(const Eigen::Vector3d& p, double margin) const {
-        const double y = yaw_deg * M_PI / 180.0;
-        const Eigen::Vector3d d = p - center;
-        const double u = std::cos(y) * d.x() + std::sin(y) * d.y();
-        const double v = -std::sin(y) * d.x() + std::cos(y) * d.y();
-        return std::abs(u) <= size.x() / 2 + margin && std::abs(v) <= size.y() / 2 + margin &&
-               std::abs(d.z()) <= size.z() / 2 + margin;
-    }
-};
-
-// What the simulated points of one session hit: every voxel, and the points of each object.
-struct Hits {
-    BoolGrid::Ptr all = BoolGrid::create(false);
-    std::map<int, std::vector<Eigen::Vector3d>> by_object;
-};
-
-Coord VoxelOf(const Eigen::Vector3d& p) {
-    return Coord(static_cast<int>(std::floor(p.x() / kVoxel)),
-                 static_cast<int>(std::floor(p.y() / kVoxel)),
-                 static_cast<int>(std::floor(p.z() / kVoxel)));
-}
-
-struct Simulated {
-    fs::path dir;
-    std::vector<Edit> edits;
-    Observation a, b;
-    Hits hits_a, hits_b;
-};
-
-Hits ReadHits(const io::KittiSequence& seq, const std::set<int>& objects) {
-    Hits hits;
-    auto acc = hits.all->getAccessor();
-    for (size_t i = 0; i < seq.size(); ++i) {
-        const core::Scan scan = io::ReadKittiScan(seq, i);
-        for (size_t p = 0; p < scan.points.size(); ++p) {
-            const Eigen::Vector3d w = scan.T_world_sensor * scan.points[p];
-            acc.setValueOn(VoxelOf(w), true);
-            const int id = scan.instances.empty() ? 0 : scan.instances[p];
-            if (objects.count(id)) hits.by_object[id].push_back(w);
-        }
-    }
-    return hits;
-}
+using testing::ChangeCase;
+using testing::ChangeScore;
 
 // Simulates the scene once per test binary, integrates both sessions into a store and reads the
 // two sessions' layers back.
-const Simulated& Scene() {
+const ChangeCase& Scene() {
     static const fs::path temp = strata::test::TempPath("change_sim");
-    static const Simulated scene = [] {
-        Simulated s;
-        s.dir = temp;
-        fs::remove_all(s.dir);
+    static const ChangeCase scene = [] {
+        ChangeCase s;
+        s.voxel = kVoxel;
+        fs::remove_all(temp);
         const fs::path scene_file =
             fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/street_two_sessions.json";
         sim::SimulateConfig config;
         config.write_picture = false;
-        (void)sim::SimulateSceneToSequence(scene_file, s.dir / "sim", config);
-
-        std::ifstream truth(s.dir / "sim/session_1/ground_truth.json");
-        const nlohmann::json j = nlohmann::json::parse(truth);
+        (void)sim::SimulateSceneToSequence(scene_file, temp / "sim", config);
+        s.edits = testing::ReadTruthEdits(temp / "sim/session_1/ground_truth.json");
         std::set<int> objects;
-        for (const auto& e : j.at("edits")) {
-            Edit edit;
-            edit.object = e.at("object");
-            edit.name = e.at("name");
-            edit.change = e.at("change");
-            edit.kind = e.at("kind");
-            for (int k = 0; k < 3; ++k) {
-                edit.center[k] = e.at("center")[k];
-                edit.size[k] = e.at("size")[k];
-            }
-            edit.yaw_deg = e.at("yaw_deg");
-            objects.insert(edit.object);
-            s.edits.push_back(edit);
-        }
+        for (const testing::TruthEdit& e : s.edits) objects.insert(e.object);
 
         store::StoreSettings settings;
         settings.voxel_size_m = kVoxel;
-        store::MapStore map = store::MapStore::Create(s.dir / "map", settings);
+        store::MapStore map = store::MapStore::Create(temp / "map", settings);
         std::vector<int64_t> sessions;
         for (const char* session : {"session_0", "session_1"}) {
-            const io::KittiSequence seq = io::OpenKittiSequence(s.dir / "sim" / session);
+            const io::KittiSequence seq = io::OpenKittiSequence(temp / "sim" / session);
             store::SessionWriter writer(map, integration::IntegrationConfig{}, {});
             for (size_t i = 0; i < seq.size(); ++i) writer.Integrate(io::ReadKittiScan(seq, i));
             sessions.push_back(writer.Commit().id);
-            (session == std::string("session_0") ? s.hits_a : s.hits_b) = ReadHits(seq, objects);
+            (session == std::string("session_0") ? s.hits_a : s.hits_b) =
+                testing::ReadSessionHits(seq, objects, kVoxel);
         }
         MapObserver observer(map);
         s.a = observer.Session(sessions[0]);
@@ -135,126 +67,12 @@ const Simulated& Scene() {
     return scene;
 }
 
-// The voxels of an edit a perfect detector would report: voxels holding points of the edited
-// object (inside its box) that the map of the side where it is present holds occupied and the
-// other side's map holds free (voxels the other side never observed are unknown by definition).
-// `strict` also leaves out voxels the other side's points hit (a voxel holding the car in one
-// session and the road under it in the other, which that map calls free after more rays passed).
-BoolGrid::Ptr TruthVoxels(const Simulated& s, const Edit& e, bool strict) {
-    const bool added = e.change == "added";
-    const Hits& present = added ? s.hits_b : s.hits_a;
-    const Hits& other_hits = added ? s.hits_a : s.hits_b;
-    const Observation& other = added ? s.a : s.b;
-    BoolGrid::Ptr out = BoolGrid::create(false);
-    const auto it = present.by_object.find(e.object);
-    if (it == present.by_object.end()) return out;
-    auto acc = out->getAccessor();
-    for (const Eigen::Vector3d& p : it->second) {
-        if (e.Contains(p, kBoxMargin)) acc.setValueOn(VoxelOf(p), true);
-    }
-    out->topologyIntersection(*other.masks.free);
-    out->topologyIntersection(*(added ? s.b : s.a).masks.occupied);
-    if (strict) out->topologyDifference(*other_hits.all);
-    return out;
-}
-
-size_t Overlap(const BoolGrid& x, const BoolGrid& y) {
-    BoolGrid::Ptr both = x.deepCopy();
-    both->topologyIntersection(y);
-    return both->activeVoxelCount();
-}
-
-struct Score {
-    double precision = 0.0, recall = 0.0, iou = 0.0;
-    size_t objects = 0, observable = 0;
-};
-
-// Scores a query: objects are attributed to the edit of their kind holding most of their voxels
-// (inside its box grown by the margin); per edit the detected voxels inside its box against
-// TruthVoxels. `table` prints the per-edit rows.
-Score Evaluate(const Simulated& s, const ChangeQuery& query, bool strict, bool table) {
-    const ChangeSet changes = DetectChanges(s.a, s.b, kVoxel, query);
-    const auto centre = [](const Coord& c) -> Eigen::Vector3d {
-        return (Eigen::Vector3d(c.x(), c.y(), c.z()) + Eigen::Vector3d::Constant(0.5)) * kVoxel;
-    };
-    const auto object_voxels = [&](const ChangeObject& o) {
-        const BoolGrid& all = o.kind == ChangeKind::kAdded ? *changes.added : *changes.removed;
-        std::vector<Coord> voxels;
-        for (auto on = all.cbeginValueOn(); on; ++on) {
-            const Eigen::Vector3d c = centre(on.getCoord());
-            if ((c.array() >= o.bbox_min.array()).all() && (c.array() <= o.bbox_max.array()).all())
-                voxels.push_back(on.getCoord());
-        }
-        return voxels;
-    };
-    std::map<size_t, size_t> matched;  // edit -> number of objects
-    size_t true_objects = 0;
-    for (const ChangeObject& o : changes.objects) {
-        int best = -1;
-        size_t best_inside = 0;
-        const std::vector<Coord> voxels = object_voxels(o);
-        for (size_t e = 0; e < s.edits.size(); ++e) {
-            if (s.edits[e].change != ChangeKindName(o.kind)) continue;
-            size_t inside = 0;
-            for (const Coord& c : voxels) {
-                inside += s.edits[e].Contains(centre(c), kBoxMargin + kVoxel) ? 1 : 0;
-            }
-            if (inside > best_inside) {
-                best_inside = inside;
-                best = static_cast<int>(e);
-            }
-        }
-        if (best >= 0 && 2 * best_inside > voxels.size()) {
-            ++true_objects;
-            ++matched[static_cast<size_t>(best)];
-        } else if (table) {
-            std::printf("[ change ] false object %d: %s, %zu voxels at (%.1f, %.1f, %.1f), %s\n",
-                        o.id, ChangeKindName(o.kind), o.voxels, o.centroid.x(), o.centroid.y(),
-                        o.centroid.z(), core::ClassName(o.dominant_class));
-        }
-    }
-    Score score;
-    score.objects = changes.objects.size();
-    size_t found = 0, inter_sum = 0, union_sum = 0;
-    if (table)
-        std::printf("[ change ] | edit | change | truth voxels | detected | IoU | objects |\n");
-    for (size_t e = 0; e < s.edits.size(); ++e) {
-        const Edit& edit = s.edits[e];
-        const BoolGrid::Ptr truth = TruthVoxels(s, edit, strict);
-        const BoolGrid& all = edit.change == "added" ? *changes.added : *changes.removed;
-        BoolGrid::Ptr detected = BoolGrid::create(false);
-        for (auto on = all.cbeginValueOn(); on; ++on) {
-            if (edit.Contains(centre(on.getCoord()), kBoxMargin + kVoxel)) {
-                detected->tree().setValueOn(on.getCoord(), true);
-            }
-        }
-        const size_t t = truth->activeVoxelCount(), d = detected->activeVoxelCount();
-        const size_t inter = Overlap(*truth, *detected);
-        const size_t uni = t + d - inter;
-        if (t >= kMinObservableVoxels) {
-            ++score.observable;
-            found += matched.count(e) ? 1 : 0;
-            inter_sum += inter;
-            union_sum += uni;
-        }
-        if (table) {
-            std::printf("[ change ] | %s (%s) | %s | %zu | %zu | %.3f | %zu |\n", edit.name.c_str(),
-                        edit.kind.c_str(), edit.change.c_str(), t, d,
-                        uni ? static_cast<double>(inter) / uni : 1.0,
-                        matched.count(e) ? matched.at(e) : size_t{0});
-        }
-    }
-    score.precision =
-        changes.objects.empty() ? 1.0 : static_cast<double>(true_objects) / changes.objects.size();
-    score.recall = score.observable ? static_cast<double>(found) / score.observable : 1.0;
-    score.iou = union_sum ? static_cast<double>(inter_sum) / union_sum : 1.0;
-    return score;
-}
-
 TEST(ChangeSimulated, StreetTwoSessionsMatchesTheEdits) {
-    const Simulated& s = Scene();
-    const Score score = Evaluate(s, ChangeQuery{}, /*strict=*/false, /*table=*/true);
-    const Score strict = Evaluate(s, ChangeQuery{}, /*strict=*/true, /*table=*/false);
+    const ChangeCase& s = Scene();
+    const ChangeScore score =
+        testing::ScoreChanges(s, ChangeQuery{}, /*strict=*/false, /*table=*/true);
+    const ChangeScore strict =
+        testing::ScoreChanges(s, ChangeQuery{}, /*strict=*/true, /*table=*/false);
     std::printf(
         "[ change ] objects %zu, precision %.3f, recall %.3f (%zu observable edits), "
         "pooled voxel IoU %.3f (strict %.3f)\n",
@@ -270,7 +88,7 @@ TEST(ChangeSimulated, StreetTwoSessionsMatchesTheEdits) {
 // what the asserts hold: each safeguard alone leaves many false objects, both leave the seven
 // edits, growth gives back IoU, the support rule changes nothing here, a wider margin costs IoU).
 TEST(ChangeSimulated, Ablation) {
-    const Simulated& s = Scene();
+    const ChangeCase& s = Scene();
     std::printf(
         "[ change ] | surface tolerance | observed margin | grow | support depth | "
         "objects | precision | recall | IoU | IoU (strict) |\n");
@@ -284,15 +102,15 @@ TEST(ChangeSimulated, Ablation) {
                         {2, 1, 2, 3, 7, 0.916},   {2, 2, 2, 3, 7, 0.873}};
     // Pooled IoU moves by a few thousandths when a handful of voxels change.
     constexpr double kIoUTolerance = 0.02;
-    std::vector<Score> scores;
+    std::vector<ChangeScore> scores;
     for (const Row& row : rows) {
         ChangeQuery q;
         q.surface_tolerance_voxels = row.tolerance;
         q.observed_margin_voxels = row.margin;
         q.grow_voxels = row.grow;
         q.support_depth_voxels = row.support;
-        const Score mapped = Evaluate(s, q, false, false);
-        const Score strict = Evaluate(s, q, true, false);
+        const ChangeScore mapped = testing::ScoreChanges(s, q, false, false);
+        const ChangeScore strict = testing::ScoreChanges(s, q, true, false);
         std::printf("[ change ] | %d | %d | %d | %d | %zu | %.3f | %.3f | %.3f | %.3f |\n",
                     row.tolerance, row.margin, row.grow, row.support, mapped.objects,
                     mapped.precision, mapped.recall, mapped.iou, strict.iou);
@@ -316,7 +134,7 @@ TEST(ChangeSimulated, Ablation) {
 // Every reported voxel was observed (occupied or free) by both sessions: where one side never
 // looked, nothing is reported, growth included.
 TEST(ChangeSimulated, NothingIsReportedWhereOneSessionNeverLooked) {
-    const Simulated& s = Scene();
+    const ChangeCase& s = Scene();
     const ChangeSet changes = DetectChanges(s.a, s.b, kVoxel, ChangeQuery{});
     const auto seen = [](const Observation& o) {
         BoolGrid::Ptr all = o.masks.occupied->deepCopy();

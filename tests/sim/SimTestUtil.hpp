@@ -12,6 +12,11 @@
 
 namespace strata::sim::test {
 
+/// Path of an example scene in datasets/scenes ("street", "district_small", ...).
+inline std::string ExampleScene(const std::string& name) {
+    return std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/" + name + ".json";
+}
+
 /// Ray-triangle distance (Moller-Trumbore, double precision); nullopt for a miss.
 inline std::optional<double> RayTriangle(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
                                          const Eigen::Vector3d& a, const Eigen::Vector3d& b,

@@ -126,7 +126,8 @@ VehicleScore ScoreVehicles(const ParkingCase& c, const core::VoxelMap& cleaned,
             }
         }
     }
-    s.surface = sim::ScoreSurface(MapPoints(cleaned), c.scene, c.reference);
+    if (!c.reference.empty())
+        s.surface = sim::ScoreSurface(MapPoints(cleaned), c.scene, c.reference);
     return s;
 }
 

@@ -17,7 +17,7 @@ struct ParkingCase {
     core::VoxelMap unlabelled;
     sim::Scene scene;                        ///< world frame = the map frame
     std::vector<Eigen::Vector3d> origins;    ///< scan positions
-    std::vector<Eigen::Vector3d> reference;  ///< surface the cleaned map should hold
+    std::vector<Eigen::Vector3d> reference;  ///< surface the cleaned map should hold (or none)
 };
 
 /// Simulates `scene_file` into `work_dir` (removed first) and maps it at `voxel_size`. The
@@ -40,7 +40,8 @@ struct VehicleScore {
 };
 inline constexpr double kMatchIoU = 0.7;
 
-/// Scores a cleaned map and the vehicles found against the scene's truth.
+/// Scores a cleaned map and the vehicles found against the scene's truth (the surface only when
+/// the case has reference points).
 [[nodiscard]] VehicleScore ScoreVehicles(const ParkingCase& c, const core::VoxelMap& cleaned,
                                          const vehicles::VehicleResult& result);
 

@@ -30,6 +30,9 @@ struct BoxTruth {
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
     Eigen::Vector3d size = Eigen::Vector3d::Zero();  ///< length, width, height
     double yaw_deg = 0.0;
+
+    /// @brief The box seen from above: the x, y bounds of its yawed footprint.
+    [[nodiscard]] Eigen::AlignedBox2d Footprint() const;
 };
 
 /// @brief A storey of a building scene and the frame its session was recorded in.

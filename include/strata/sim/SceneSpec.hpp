@@ -57,6 +57,7 @@ struct SceneSpec {
     std::string source;  ///< file it was read from, for error messages
     uint64_t seed = 1;
     std::string sensor = "hdl64";
+    double surface_spacing_m = 0.1;  ///< static surface sample unless the caller sets one
     std::vector<ObjectSpec> objects;
     std::vector<SessionSpec> sessions;  ///< at least one
     std::vector<double> floor_z;        ///< building scenes: z offset of each storey

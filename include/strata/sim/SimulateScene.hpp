@@ -19,7 +19,7 @@ struct SimulateConfig {
     int max_scans = 0;                    ///< > 0 caps the scans of every session
     bool motion = false;                  ///< sensor motion during each sweep (raw, not deskewed)
     std::optional<double> range_noise_m;  ///< unset = the sensor's default (0.02 m)
-    double surface_spacing_m = 0.1;       ///< spacing of the static surface sample
+    double surface_spacing_m = 0.0;       ///< static surface sample spacing; 0 = the scene's
     bool mark_observed = true;            ///< flag surface points in line of sight of the path
     bool write_picture = true;            ///< picture.png (top-down, by class) in each sequence
     PictureConfig picture;
@@ -34,7 +34,8 @@ struct SessionReport {
     std::filesystem::path dir;
     size_t scans = 0, points = 0, rays = 0, triangles = 0;
     size_t walls = 0, vehicles = 0, edits = 0, surface_points = 0;
-    double trace_seconds = 0.0;  ///< wall-clock time spent ray tracing sweeps
+    double surface_spacing_m = 0.0;  ///< spacing the static surface was sampled at
+    double trace_seconds = 0.0;      ///< wall-clock time spent ray tracing sweeps
 };
 
 /// @brief What SimulateSceneToSequence wrote, one entry per session.
@@ -47,8 +48,8 @@ using SimulateProgress = std::function<void(size_t, size_t)>;
 
 /// @brief Simulates every session of a scene into SemanticKITTI sequences with ground truth:
 /// `out_dir` itself for a one-session scene, else `out_dir/session_<k>` for each session.
-/// @note Throws InvalidArgumentError for a bad config, FormatError for a bad scene, IoError naming the
-/// file on I/O failure. Uses all TBB threads; limit them in the caller.
+/// @note Throws InvalidArgumentError for a bad config, FormatError for a bad scene, IoError naming
+/// the file on I/O failure. Uses all TBB threads; limit them in the caller.
 [[nodiscard]] SimulateReport SimulateSceneToSequence(const SceneSpec& scene,
                                                      const std::filesystem::path& out_dir,
                                                      const SimulateConfig& config = {},

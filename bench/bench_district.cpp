@@ -1,0 +1,154 @@
+// The district the scale-out work is measured on (docs/simulator.md, "Districts"; docs/bench.md,
+// "District"): `strata simulate` of datasets/scenes/district.json, then `strata integrate` of each
+// session at 0.2 m, each timed and its peak RSS taken from the kernel (wait4), then the map's
+// tiles and size from `strata info --json`. Takes minutes; not run in CI.
+// Usage: bench_district [--scene FILE] [--work DIR] [--memory-budget MB] [--keep]
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+    double seconds = 0.0;
+    double peak_rss_mb = 0.0;
+};
+
+// Runs the program with `args`, its stdout into `out`; exits when it fails.
+Run Execute(const std::vector<std::string>& args, const fs::path& out) {
+    std::fflush(stdout);  // else the child would write our buffered lines again
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = fork();
+    if (pid == 0) {
+        if (!freopen(out.c_str(), "w", stdout)) _exit(127);
+        std::vector<char*> argv;
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(argv[0], argv.data());
+        _exit(127);
+    }
+    int status = 0;
+    rusage usage{};
+    if (pid < 0 || wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) ||
+        WEXITSTATUS(status) != 0) {
+        std::fprintf(stderr, "bench_district: %s failed\n", args[1].c_str());
+        std::exit(1);
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return {seconds, static_cast<double>(usage.ru_maxrss) / 1024.0};  // ru_maxrss is in KiB
+}
+
+std::string Shell(const std::string& command) {
+    std::string text;
+    if (FILE* p = popen(command.c_str(), "r")) {
+        char buffer[512];
+        while (fgets(buffer, sizeof buffer, p)) text += buffer;
+        pclose(p);
+    }
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    return text;
+}
+
+double Megabytes(const fs::path& dir) {
+    uintmax_t bytes = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        if (e.is_regular_file()) bytes += e.file_size();
+    }
+    return static_cast<double>(bytes) / 1e6;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    fs::path scene = fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/district.json";
+    fs::path work = fs::temp_directory_path() / "bench_district";
+    std::string budget = "0";
+    bool keep = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--scene" && i + 1 < argc)
+            scene = argv[++i];
+        else if (a == "--work" && i + 1 < argc)
+            work = argv[++i];
+        else if (a == "--memory-budget" && i + 1 < argc)
+            budget = argv[++i];
+        else if (a == "--keep")
+            keep = true;
+        else {
+            std::fprintf(stderr,
+                         "usage: %s [--scene FILE] [--work DIR] [--memory-budget MB] [--keep]\n",
+                         argv[0]);
+            return 2;
+        }
+    }
+    const std::string strata = STRATA_BINARY;
+    if (strata.empty()) {
+        std::fprintf(stderr, "bench_district: the strata program was not built\n");
+        return 1;
+    }
+    fs::remove_all(work);
+    fs::create_directories(work);
+    std::printf(
+        "%s, commit %s, %s, %u threads\nload before: %s\n", scene.filename().c_str(),
+        Shell("git -C " + std::string(STRATA_SOURCE_DIR) + " rev-parse --short HEAD").c_str(),
+        Shell("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'").c_str(),
+        std::thread::hardware_concurrency(), Shell("uptime").c_str());
+    // Step 1: simulate every session (pictures at 1 m: a 990 px overview of the district).
+    const Run sim = Execute({strata, "simulate", "--scene", scene.string(), "--out",
+                             (work / "sim").string(), "--picture-pixel", "1", "--json"},
+                            work / "simulate.json");
+    std::ifstream sim_in(work / "simulate.json");
+    const nlohmann::json report = nlohmann::json::parse(sim_in);
+    const double sim_mb = Megabytes(work / "sim");
+    std::printf(
+        "\n| step | scans | points | s | peak RSS MB | output MB |\n|---|---|---|---|---|---|\n");
+    size_t scans = 0, points = 0;
+    for (const auto& s : report.at("sessions")) {
+        scans += s.at("scans").get<size_t>();
+        points += s.at("points").get<size_t>();
+    }
+    std::printf("| simulate (%zu sessions) | %zu | %zu | %.0f | %.0f | %.0f |\n",
+                report.at("sessions").size(), scans, points, sim.seconds, sim.peak_rss_mb, sim_mb);
+    // Step 2: integrate each session into one map at 0.2 m (64 m tiles, the defaults).
+    double integrate_s = 0.0, integrate_rss = 0.0;
+    for (const auto& s : report.at("sessions")) {
+        const Run r =
+            Execute({strata, "integrate", (work / "map").string(), "--kitti",
+                     s.at("dir").get<std::string>(), "--voxel", "0.2", "--memory-budget", budget},
+                    work / "integrate.txt");
+        integrate_s += r.seconds;
+        integrate_rss = std::max(integrate_rss, r.peak_rss_mb);
+        std::printf("| integrate %s | %zu | %zu | %.0f | %.0f | %.0f |\n",
+                    s.at("name").get<std::string>().c_str(), s.at("scans").get<size_t>(),
+                    s.at("points").get<size_t>(), r.seconds, r.peak_rss_mb,
+                    Megabytes(work / "map"));
+    }
+    // Step 3: what the map holds.
+    (void)Execute({strata, "info", (work / "map").string(), "--json"}, work / "info.json");
+    std::ifstream info_in(work / "info.json");
+    const nlohmann::json info = nlohmann::json::parse(info_in);
+    std::printf(
+        "\nsimulate %.0f s, integrate %.0f s (peak RSS %.0f MB, --memory-budget %s); "
+        "map: %d tiles of %.0f m, %.0f MB on disk (%.0f MB of current tiles), %.1f M "
+        "occupied and %.1f M free voxels\nload after: %s\n",
+        sim.seconds, integrate_s, integrate_rss, budget.c_str(), info.at("tiles").get<int>(),
+        info.at("tile_size_m").get<double>(), Megabytes(work / "map"),
+        info.at("tile_bytes").get<double>() / 1e6, info.at("occupied_voxels").get<double>() / 1e6,
+        info.at("free_voxels").get<double>() / 1e6, Shell("uptime").c_str());
+    if (!keep) fs::remove_all(work);
+    return 0;
+}
