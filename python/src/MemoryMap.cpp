@@ -15,7 +15,8 @@ namespace {
 MemoryMap CreateMemoryMap(double voxel, double max_range, double min_range, bool points_only,
                           bool keep_point_means) {
     MemoryMap m;
-    const pipeline::RuleRequest rule = RuleFrom(max_range, min_range, points_only, keep_point_means);
+    const pipeline::RuleRequest rule =
+        RuleFrom(max_range, min_range, points_only, keep_point_means);
     rule.Validate();
     m.config = rule.ForNewMap();
     if (!(voxel > 0.0)) throw InvalidArgumentError("voxel must be > 0 (metres)");

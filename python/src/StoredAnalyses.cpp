@@ -107,8 +107,7 @@ py::dict Localize(const StoredMap& m, const py::array& points, int floor, const 
     return report;
 }
 
-py::dict Walls(const StoredMap& m, const std::string& as_of, bool save,
-               const py::kwargs& options) {
+py::dict Walls(const StoredMap& m, const std::string& as_of, bool save, const py::kwargs& options) {
     const walls::WallConfig config = WallConfigFrom(options);
     MapStore& store = m.Get();
     if (save) CheckSave(store, as_of, "walls");

@@ -18,7 +18,8 @@ std::pair<size_t, size_t> ParseFrames(const std::string& text, size_t n) {
         const auto colon = text.find(':');
         if (colon == std::string::npos) {
             const size_t a = std::stoul(text);
-            return {a, a + 1};
+            if (a < n) return {a, a + 1};
+            throw std::out_of_range(text);
         }
         const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
         const size_t begin = a.empty() ? 0 : std::stoul(a);
