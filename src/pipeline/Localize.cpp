@@ -16,7 +16,7 @@ namespace reg = registration;
 // The storey's slice of the stacked map (every storey moved into the map frame, then cut) as a
 // surface, then the scan `read` gives registered to it.
 Localization Run(const store::MapStore& map, const LocalizeOptions& options,
-                 const std::function<std::vector<Eigen::Vector3d>()>& read) {
+                 const std::function<const std::vector<Eigen::Vector3d>&()>& read) {
     options.Validate();
     const std::vector<FloorRecord> floors = ReadFloors(map);
     const auto it = std::find_if(floors.begin(), floors.end(),
@@ -42,7 +42,7 @@ Localization Run(const store::MapStore& map, const LocalizeOptions& options,
         throw RefusedError("floor " + std::to_string(options.floor) +
                            " has no surface in its slice");
     }
-    const std::vector<Eigen::Vector3d> points = read();
+    const std::vector<Eigen::Vector3d>& points = read();
     Localization l;
     l.floor = options.floor;
     l.z_m = it->z_m;
@@ -71,12 +71,16 @@ AlignOptions LocalizeOptions::DefaultAlign() {
 
 Localization Localize(const store::MapStore& map, const std::vector<Eigen::Vector3d>& points,
                       const LocalizeOptions& options) {
-    return Run(map, options, [&] { return points; });
+    return Run(map, options, [&]() -> const std::vector<Eigen::Vector3d>& { return points; });
 }
 
 Localization LocalizeFile(const store::MapStore& map, const std::filesystem::path& scan_file,
                           const LocalizeOptions& options) {
-    return Run(map, options, [&] { return ReadScanFile(scan_file).points; });
+    core::Scan scan;  // read once the storey is found
+    return Run(map, options, [&]() -> const std::vector<Eigen::Vector3d>& {
+        scan = ReadScanFile(scan_file);
+        return scan.points;
+    });
 }
 
 nlohmann::json LocalizationJson(const Localization& l) {

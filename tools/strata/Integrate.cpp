@@ -59,7 +59,6 @@ void PrintStart(const pipeline::IntegrationStart& s, const IntegrateArgs& args) 
 }
 
 void Run(const IntegrateArgs& args, const CLI::App& cmd) {
-    args.scans.Validate();
     std::unique_ptr<tbb::global_control> limit;
     if (args.threads > 0) {
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
