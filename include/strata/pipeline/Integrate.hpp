@@ -33,6 +33,7 @@ struct IntegrateOptions {
     ProgressCallback progress;  ///< stages "reading scans" (with `align`), "integrating"
     /// Called with the alignment before it is accepted or refused (to report it either way).
     std::function<void(const MapAlignment&)> on_aligned;
+    /// Called once before the first scan (the program prints the effective configuration).
     std::function<void(const IntegrationStart&)> on_start;
 
     /// @brief Throws InvalidArgumentError naming the first bad field.
