@@ -15,7 +15,7 @@ void RegisterReaders(py::module_& m);
 void RegisterSimulation(py::module_& m);
 /// VoxelMap: a map in memory, its integration, queries and export.
 void RegisterMemoryMap(py::module_& m);
-/// Map and Session: a map on disk (StoredMap.cpp holds every call into the store).
+/// Map and Session: a map on disk (StoredMap.cpp, Session.cpp, StoredAnalyses.cpp).
 void RegisterStoredMap(py::module_& m);
 
 }  // namespace strata::python

@@ -15,7 +15,10 @@ namespace {
 MemoryMap CreateMemoryMap(double voxel, double max_range, double min_range, bool points_only,
                           bool keep_point_means) {
     MemoryMap m;
-    m.config = IntegrationRule(max_range, min_range, points_only, keep_point_means);
+    const pipeline::RuleRequest rule =
+        RuleFrom(max_range, min_range, points_only, keep_point_means);
+    rule.Validate();
+    m.config = rule.ForNewMap();
     if (!(voxel > 0.0)) throw InvalidArgumentError("voxel must be > 0 (metres)");
     m.map = std::make_shared<core::VoxelMap>(core::VoxelMap::Create(voxel));
     return m;
@@ -59,15 +62,14 @@ py::dict WallsInMemory(const MemoryMap& self, const py::kwargs& options) {
 
 }  // namespace
 
-integration::IntegrationConfig IntegrationRule(double max_range, double min_range, bool points_only,
-                                               bool keep_point_means) {
-    integration::IntegrationConfig config;
-    config.max_range_m = max_range;
-    config.min_range_m = min_range;
-    config.points_only = points_only;
-    config.keep_point_means = keep_point_means;
-    config.Validate();
-    return config;
+pipeline::RuleRequest RuleFrom(double max_range, double min_range, bool points_only,
+                               bool keep_point_means) {
+    pipeline::RuleRequest rule;
+    rule.max_range_m = max_range;
+    rule.min_range_m = min_range;
+    rule.points_only = points_only;
+    rule.keep_point_means = keep_point_means;
+    return rule;
 }
 
 py::dict UpdateCounts(size_t points, size_t dropped, size_t clipped) {

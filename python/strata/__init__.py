@@ -86,8 +86,10 @@ class Session:
         self._impl = _strata._Session(map._impl, name, memory_budget_mb)
 
     def integrate(self, points, pose, labels=None, classes=None) -> dict:
-        """Integrates one scan (see VoxelMap.integrate for the arrays); nothing reaches the
-        map on disk before commit(). Returns {"points", "dropped", "clipped"}."""
+        """Integrates one scan (see VoxelMap.integrate for the arrays) with the map's
+        integration rule, through the same session writer as `strata integrate`; nothing
+        reaches the map on disk before commit(). Returns {"points", "dropped", "clipped"}.
+        An error about the scan names it ("scan 3 (numpy): ...")."""
         return self._impl.integrate(points, pose, labels, classes)
 
     def commit(self) -> dict:
@@ -203,21 +205,36 @@ class Map:
         """VoxelMap.columns on the newest state."""
         return self.snapshot().columns(window)
 
-    def walls(self, as_of=None, **options) -> dict:
-        """VoxelMap.walls on the newest state (or as of a session): the walls and their slant
-        angles as `strata walls --json --no-save` reports them, plus the wall voxels as arrays.
-        Options are WallConfig's fields (docs/walls.md)."""
-        return (self.snapshot() if as_of is None else self.as_of(as_of)).walls(**options)
+    def walls(self, as_of=None, save: bool = False, **options) -> dict:
+        """Walls and their slant angles (docs/walls.md) of the newest state (or as of a
+        session), as `strata walls --json` reports them (walls, stats, config, ...), plus
+        "voxels": the centre, slant_deg and wall_id of every wall voxel as arrays. Options are
+        WallConfig's fields (window_m=1.5, level_to_ground=True, ...).
+
+        save=True stores them in the map as `strata walls` does (one commit: the slant_deg and
+        wall_id grids and the walls table, `SELECT * FROM walls`) and adds "commit"; it needs
+        the map open for writing and no as_of. Bad options are refused before anything is
+        read or written."""
+        return self._impl.walls("" if as_of is None else str(as_of), save, **options)
 
     def vehicles(self, as_of=None, source: str = "auto", ray_check: bool = True,
-                 refill: bool = True) -> dict:
+                 refill: bool = True, save: bool = False) -> dict:
         """Parked vehicles cleared and the ground under them refilled (docs/vehicles.md), as
-        `strata vehicles --json --no-save` reports them: vehicles [{id, center, size, yaw_deg,
-        source, cleared_voxels, refilled_cells, refused_cells}], ... plus "map": the cleaned map
-        as a read-only VoxelMap. source: "auto", "label" or "geometric". The map on disk is not
-        changed."""
-        return self._impl.vehicles("" if as_of is None else str(as_of), source, ray_check,
-                                   refill)
+        `strata vehicles --json` reports them: vehicles [{id, center, size, yaw_deg, source,
+        cleared_voxels, refilled_cells, refused_cells}], ... plus "map": the cleaned map as a
+        read-only VoxelMap. source: "auto", "label" or "geometric".
+
+        save=False (the default) leaves the map on disk unchanged. save=True stores the result
+        as `strata vehicles` does (one commit: the cleaned map, the vehicle_cleared and
+        vehicle_refilled grids and the vehicles table; as_of the previous session still shows
+        the map as it was) and adds "commit"; "map" is then the map as stored. It needs the map
+        open for writing and no as_of."""
+        report = self._impl.vehicles("" if as_of is None else str(as_of), source, ray_check,
+                                     refill, save)
+        if save:
+            self._newest = None
+            report["map"] = self.snapshot()
+        return report
 
     def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
              gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
@@ -247,6 +264,26 @@ class Map:
         has no surface near the guess. The map is only read."""
         return self._impl.register(points, init, "" if as_of is None else str(as_of), margin,
                                    min_range, max_range, min_overlap, max_rmse)
+
+    def localize(self, points, floor: int, init=None, l1: float = -0.2, l2: float = 3.1,
+                 min_range: float = 0.5, max_range: float = 60.0, min_overlap=None,
+                 max_rmse=None) -> dict:
+        """Where one scan (points (N, 3) in its sensor frame) sits in storey `floor` of a
+        stacked map (`strata stack` records the storeys; docs/registration.md), registered to
+        the slice l1 < z - z_floor < l2 of the map only, as `strata localize --json` reports it:
+        T (16 numbers, row-major, scan -> map), converged, rmse_m, overlap, refusal, xyz_m,
+        yaw_deg, iterations, map_points, floor, z_m, ... plus "pose" as a (4, 4) array.
+
+        init: the guess in the map frame, a 4x4 pose or (x, y, z, yaw_deg) (default: the
+        storey's frame). Points outside [min_range, max_range] of the sensor are left out;
+        min_overlap and max_rmse default to the program's. A registration refused on its merits
+        comes back with converged False and the reason in "refusal"; InvalidArgumentError for a
+        storey that is not recorded, RefusedError when its slice holds no surface. The map is
+        only read."""
+        if isinstance(floor, bool) or not isinstance(floor, (int, np.integer)):
+            raise InvalidArgumentError(f"floor must be a storey index (an int); got {floor!r}")
+        return self._impl.localize(points, int(floor), init, l1, l2, min_range, max_range,
+                                   min_overlap, max_rmse)
 
     def export(self, path, format: str = "", as_of=None) -> str:
         """Writes the map (or its state as of a session) as vdb, bt, ot, ply or png

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "strata/core/Error.hpp"
 #include "strata/registration/MapRegion.hpp"
@@ -16,6 +17,16 @@ double MsSince(std::chrono::steady_clock::time_point start) {
 }
 
 }  // namespace
+
+Eigen::Isometry3d GuessFromXyzYaw(const std::vector<double>& xyz_yaw_deg) {
+    if (xyz_yaw_deg.empty()) return Eigen::Isometry3d::Identity();
+    if (xyz_yaw_deg.size() != 4) throw InvalidArgumentError("--init: expected x,y,z,yaw_deg");
+    for (double v : xyz_yaw_deg) {
+        if (!std::isfinite(v)) throw InvalidArgumentError("--init: values must be finite");
+    }
+    const std::vector<double>& v = xyz_yaw_deg;
+    return registration::PoseFromXyzYaw(v[0], v[1], v[2], v[3]);
+}
 
 MapAlignment AlignToMap(const store::MapStore& map, const store::Snapshot& snapshot,
                         const SourceCloud& cloud, const Eigen::Isometry3d& guess,

@@ -1,6 +1,8 @@
 #include "strata/pipeline/Diff.hpp"
 
 #include "strata/change/ChangeReport.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/integration/Integrator.hpp"
 
 namespace strata::pipeline {
 
@@ -23,6 +25,52 @@ DiffResult CompareSides(const DiffSide& a, const DiffSide& b, const store::MapSt
     const change::ReportContext context{a.name, b.name, map.settings().origin, &query};
     result.report = change::ChangeReportJson(result.changes, context);
     return result;
+}
+
+DiffSide ObserveScans(const store::MapStore& map, const ScanSpec& scans) {
+    const ScanSource source = ScanSource::Open(scans, map.settings().origin);
+    core::VoxelMap scratch = map.EmptyMap();  // the Observation shares its grids
+    // The rule the map was built with, so the two sides weigh evidence alike.
+    integration::Integrator integrator(scratch, map.settings().integration);
+    for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
+    return {change::ObserveMap(scratch),
+            "scans " + source.Describe() + " (" + std::to_string(source.size()) + ", uncommitted)"};
+}
+
+int64_t SaveChangeSet(store::MapStore& map, const DiffSide& a, const DiffSide& b,
+                      const DiffResult& diff) {
+    const change::ChangeSet& changes = diff.changes;
+    store::ProductCommit product;
+    product.kind = "change_sets";
+    product.rows.push_back(nlohmann::json{{"from_side", a.name},
+                                          {"to_side", b.name},
+                                          {"added_voxels", changes.added_voxels_total},
+                                          {"removed_voxels", changes.removed_voxels_total},
+                                          {"unknown_voxels", changes.unknown_voxels},
+                                          {"objects", changes.objects.size()},
+                                          {"report", nlohmann::json::parse(diff.report)}}
+                               .dump());
+    (void)map.CommitProduct(product);
+    return map.ProductRows("change_sets").back().id;
+}
+
+nlohmann::json ChangeSetsJson(const store::MapStore& map) {
+    nlohmann::json sets = nlohmann::json::array();
+    for (const store::ProductRow& row : map.ProductHistory("change_sets")) {
+        nlohmann::json j = nlohmann::json::parse(row.json, nullptr, false);
+        if (!j.is_object()) {
+            throw FormatError(map.dir().string() + ": change set " + std::to_string(row.id) +
+                              " is damaged");
+        }
+        // The list keeps the keys it always had: the view's from_side/to_side as from/to.
+        nlohmann::json entry = {
+            {"id", row.id}, {"commit", row.commit}, {"created_utc", row.time_utc}};
+        for (const auto& [key, value] : j.items()) {
+            entry[key == "from_side" ? "from" : key == "to_side" ? "to" : key] = value;
+        }
+        sets.push_back(entry);
+    }
+    return sets;
 }
 
 }  // namespace strata::pipeline

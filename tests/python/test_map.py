@@ -92,3 +92,19 @@ def test_a_committed_session_cannot_be_used_again(tmp_path, demo_scans):
             integrate(s, demo_scans[:1])
         with pytest.raises(strata.InvalidArgumentError, match="committed or aborted"):
             integrate(s, demo_scans[1:2])
+
+
+def test_an_integration_error_names_the_scan_and_leaves_the_map(tmp_path):
+    # A 100 m hall at 1 cm voxels: far over the per-scan memory budget (as the program's test,
+    # tests/tools/TestCli.cpp), refused by the writer `strata integrate` uses, naming the scan.
+    rng = np.random.default_rng(5)
+    directions = rng.uniform(-1.0, 1.0, (4000, 3))
+    hall = directions * (np.array([50.0, 40.0, 5.0]) / np.abs(directions)).min(axis=1)[:, None]
+    path = tmp_path / "fine"
+    with strata.Map.create(path, voxel=0.01) as m:
+        before = tree_digest(path)
+        with pytest.raises(strata.RefusedError, match=r"^scan 0 \(numpy\): .*larger voxel size"):
+            with m.session() as s:
+                s.integrate(hall, np.eye(4))
+        assert m.sessions() == []
+    assert tree_digest(path) == before

@@ -3,12 +3,11 @@
 // scratch directories and a byte-level view of a map's tile files.
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <array>
@@ -23,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "SyntheticRoom.hpp"
 #include "TempPath.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
@@ -56,18 +56,26 @@ inline Result Strata(const std::string& args) {
 }
 
 /// The exit codes of tools/strata/Main.cpp, one per kind of strata::Error (README, "Exit codes").
-enum ExitCode : int { kFailed = 1, kUsage = 2, kLocked = 3, kRefused = 4, kNotFound = 5,
-                      kBadFormat = 6 };
+enum ExitCode : int {
+    kFailed = 1,
+    kUsage = 2,
+    kLocked = 3,
+    kRefused = 4,
+    kNotFound = 5,
+    kBadFormat = 6
+};
 
 /// A normal exit with exactly `code` whose output contains `message`: a crash, another code or a
 /// silent failure is not accepted. Use as EXPECT_TRUE(FailedWith(r, kNotFound, "no map")).
-inline ::testing::AssertionResult FailedWith(const Result& r, int code, const std::string& message) {
+inline ::testing::AssertionResult FailedWith(const Result& r, int code,
+                                             const std::string& message) {
     if (r.signal != 0) {
         return ::testing::AssertionFailure() << "died by signal " << r.signal << ":\n" << r.out;
     }
     if (r.code != code) {
-        return ::testing::AssertionFailure() << "exit code " << r.code << ", expected " << code
-                                             << ":\n" << r.out;
+        return ::testing::AssertionFailure()
+               << "exit code " << r.code << ", expected " << code << ":\n"
+               << r.out;
     }
     if (r.out.find(message) == std::string::npos) {
         return ::testing::AssertionFailure() << "output does not name \"" << message << "\":\n"
@@ -157,64 +165,12 @@ inline std::string ReadText(const fs::path& file) {
     return text.str();
 }
 
-/// Every tile file of a map with its bytes: equal before and after means the map is untouched.
-/// The catalog is left out (SQLite may checkpoint it on any open); compare its view instead.
-inline std::map<std::string, std::string> MapFiles(const fs::path& map) {
-    std::map<std::string, std::string> files;
-    for (const auto& e : fs::recursive_directory_iterator(map)) {
-        if (!e.is_regular_file() || e.path().filename() == "writer.lock") continue;
-        if (e.path().filename().string().rfind("catalog.sqlite", 0) == 0) continue;
-        std::ifstream in(e.path(), std::ios::binary);
-        std::ostringstream bytes;
-        bytes << in.rdbuf();
-        files[fs::relative(e.path(), map).string()] = bytes.str();
-    }
-    return files;
-}
-
-/// What MakeSequence writes. The defaults are a 6 x 5 x 3 m room seen from three poses.
-struct SequenceSpec {
-    int scans = 3;
-    int points_per_scan = 4000;
-    Eigen::Vector3d room_half_m = Eigen::Vector3d(3.0, 2.5, 1.5);
-    double step_m = 0.5;  // the sensor moves this far along x per scan
-    unsigned seed = 5;
-};
-
-/// A KITTI sequence (velodyne/*.bin and poses.txt) of a box room centred on each sensor pose:
-/// good enough for a test, and deterministic for a given spec.
-inline fs::path MakeSequence(const fs::path& dir, const SequenceSpec& spec = {}) {
-    fs::remove_all(dir);
-    fs::create_directories(dir / "velodyne");
-    std::mt19937 rng(spec.seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    std::vector<Eigen::Isometry3d> poses;
-    for (int k = 0; k < spec.scans; ++k) {
-        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-        T.translation() = Eigen::Vector3d(spec.step_m * k + 0.13, 0.07, 0.03);
-        poses.push_back(T);
-        std::vector<Eigen::Vector3d> points;
-        for (int i = 0; i < spec.points_per_scan; ++i) {
-            // z, y, x, one draw each: argument order is unspecified (gcc right to left, clang
-            // left to right) and the scan must not depend on the compiler; gcc's order is kept.
-            Eigen::Vector3d d;
-            d.z() = u(rng);
-            d.y() = u(rng);
-            d.x() = u(rng);
-            const double t = (spec.room_half_m.array() / d.array().abs()).minCoeff();
-            points.push_back(d * t);
-        }
-        char name[32];
-        std::snprintf(name, sizeof(name), "%06d.bin", k);
-        strata::io::WriteKittiBin(dir / "velodyne" / name, points);
-    }
-    strata::io::WriteKittiPoses(dir / "poses.txt", poses);
-    return dir;
-}
+// Scans of a box room and the tile-file view of a map (tests/support/SyntheticRoom.hpp).
+using strata::test::MakeSequence;
+using strata::test::MapFiles;
+using strata::test::SequenceSpec;
 
 /// A scratch path unique to this process, removed first and at exit: "strata_cli_NAME_PID".
-inline fs::path Temp(const std::string& name) {
-    return strata::test::TempPath("cli_" + name);
-}
+inline fs::path Temp(const std::string& name) { return strata::test::TempPath("cli_" + name); }
 
 }  // namespace strata::tools::test

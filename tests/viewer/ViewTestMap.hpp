@@ -117,7 +117,7 @@ inline TestMap BuildTestMap(const std::string& name) {
             id->tree().setValue(v.getCoord(), 1);
         }
     }
-    store::ProductCommit walls;  // as `strata walls` stores them (tools/strata/Walls.cpp)
+    store::ProductCommit walls;  // as `strata walls` stores them (src/pipeline/Walls.cpp)
     walls.kind = "walls";
     walls.grids = {slant, id};
     walls.rows.push_back(nlohmann::json{
@@ -138,7 +138,7 @@ inline TestMap BuildTestMap(const std::string& name) {
     const change::ChangeQuery query;
     const change::ChangeSet changes =
         change::DetectChanges(observer.Session(1), observer.Session(2), kVoxel, query);
-    // As tools/strata/Diff.cpp stores it.
+    // As pipeline::SaveChangeSet (src/pipeline/Diff.cpp) stores it.
     const auto save = [&](const std::string& from, const std::string& to) {
         store::ProductCommit set;
         set.kind = "change_sets";

@@ -1,11 +1,6 @@
 #include "Alignment.hpp"
 
-#include <cmath>
 #include <iomanip>
-
-#include "Progress.hpp"
-#include "strata/core/Error.hpp"
-#include "strata/registration/SessionCloud.hpp"
 
 namespace strata::tools {
 
@@ -29,39 +24,11 @@ void AddAlignOptions(CLI::App& cmd, AlignArgs& args, bool ranges) {
         ->capture_default_str();
 }
 
-Eigen::Isometry3d InitialGuess(const AlignArgs& args) {
-    if (args.init.empty()) return Eigen::Isometry3d::Identity();
-    for (double v : args.init) {
-        if (!std::isfinite(v)) throw InvalidArgumentError("--init: values must be finite");
-    }
-    return registration::PoseFromXyzYaw(args.init[0], args.init[1], args.init[2], args.init[3]);
+pipeline::AlignRequest AlignRequestOf(const AlignArgs& args) {
+    return {args, pipeline::GuessFromXyzYaw(args.init)};
 }
 
-SourceCloud ReadSourceCloud(const ScanSource& source, bool as_is, const AlignArgs& args) {
-    if (source.size() == 0) throw InvalidArgumentError("no scans to align");
-    registration::SessionCloudConfig cloud_config;
-    cloud_config.min_range_m = args.min_range_m;
-    cloud_config.max_range_m = args.max_range_m;
-    SourceCloud cloud;
-    cloud.scans = source.size();
-    if (as_is && source.size() == 1) {
-        core::Scan scan = source.Read(0);
-        scan.T_world_sensor = Eigen::Isometry3d::Identity();
-        cloud.single_scan = true;
-        cloud.points = std::move(scan.points);
-        return cloud;
-    }
-    registration::CloudAccumulator acc(cloud_config);
-    Progress progress("reading scans", source.size());
-    for (size_t i = 0; i < source.size(); ++i) {
-        acc.Add(source.Read(i));
-        progress.Advance();
-    }
-    cloud.points = acc.points();
-    return cloud;
-}
-
-void PrintAlignment(const MapAlignment& a, std::ostream& out) {
+void PrintAlignment(const pipeline::MapAlignment& a, std::ostream& out) {
     const registration::RegistrationResult& r = a.result;
     const Eigen::Vector3d t = r.T_map_source.translation();
     out << std::fixed << std::setprecision(3);

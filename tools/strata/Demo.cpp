@@ -8,9 +8,9 @@
 #include "Commands.hpp"
 #include "DemoScene.hpp"
 #include "MapAccess.hpp"
-#include "ScanSource.hpp"
-#include "strata/io/PngExport.hpp"
-#include "strata/io/VdbExport.hpp"
+#include "Progress.hpp"
+#include "strata/pipeline/Export.hpp"
+#include "strata/pipeline/Integrate.hpp"
 
 namespace strata::tools {
 
@@ -35,22 +35,18 @@ void Run(const DemoArgs& args) {
     }
     const fs::path map_dir = out / "map";
     fs::remove_all(map_dir);  // the demo always starts from an empty map
-    store::StoreSettings settings;
-    settings.voxel_size_m = args.voxel;
-    store::MapStore store = store::MapStore::Create(map_dir, settings);
-    const ScanSource source = ScanSource::Kitti(sequence, "");
-    store::SessionOptions options;
+    pipeline::ScanSpec scans;
+    scans.kitti = sequence;
+    pipeline::IntegrateOptions options;
+    options.map.voxel_size_m = args.voxel;
     options.name = "demo";
-    options.source = source.Describe();
-    store::SessionWriter writer(store, integration::IntegrationConfig{}, options);
-    IntegrateScans(writer, source);
-    const store::SessionRecord session = writer.Commit();
+    options.progress = ProgressBars();
+    const store::SessionRecord session =
+        pipeline::IntegrateSession(map_dir, scans, options).session;
+    const store::MapStore store = OpenMap(map_dir);
     const core::VoxelMap map = store.LoadMap(store.Latest());
-    io::WriteVdb(map, out / "map.vdb");
-    io::TopDownOptions png;
-    png.pixels_per_voxel = 2;
-    png.color_by_height = map.label->activeVoxelCount() == 0;  // unlabelled: show heights
-    io::WriteTopDownPng(map, out / "map.png", png);
+    (void)pipeline::ExportMap(map, out / "map.vdb");
+    (void)pipeline::ExportMap(map, out / "map.png");  // unlabelled maps coloured by height
     std::cout << "integrated " << session.scans << " scans (" << session.points << " points) from "
               << sequence.string() << "\n"
               << "map:     " << map_dir.string() << "  (strata info " << map_dir.string() << ")\n"
@@ -67,7 +63,8 @@ void RegisterDemo(CLI::App& app) {
         "demo", "Build a map from KITTI 00 (or a simulated street) and export VDB + PNG");
     cmd->footer("Example:\n  strata demo --out strata-demo && vdb_print -l strata-demo/map.vdb");
     cmd->add_option("--out", args->out, "Output folder")->capture_default_str();
-    cmd->add_option("--data", args->data, "Real data folder (default: $STRATA_DATA_DIR or ../shared/data)");
+    cmd->add_option("--data", args->data,
+                    "Real data folder (default: $STRATA_DATA_DIR or ../shared/data)");
     cmd->add_option("--voxel", args->voxel, "Voxel size in metres")->capture_default_str();
     cmd->callback([args] { Run(*args); });
 }

@@ -8,12 +8,10 @@
 #include <optional>
 
 #include "Commands.hpp"
-#include "strata/core/Error.hpp"
 #include "MapAccess.hpp"
-#include "ScanSource.hpp"
 #include "strata/change/ChangeReport.hpp"
 #include "strata/change/MapObserver.hpp"
-#include "strata/integration/Integrator.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::tools {
 
@@ -50,51 +48,20 @@ constexpr const char* kSideHelp =
 // One side of the query, resolved against the map, with the name the report gives it.
 using Side = pipeline::DiffSide;
 
-// The scans of --to-kitti / --to-scans integrated in memory with the map's voxel size and origin.
-Side ObserveScans(const DiffArgs& args, const store::MapStore& map) {
-    io::ReadOptions read_options;
-    read_options.origin = map.settings().origin;
-    const ScanSource source = args.to_kitti.empty()
-                                  ? ScanSource::Files({args.to_scans.begin(), args.to_scans.end()},
-                                                      args.poses, read_options)
-                                  : ScanSource::Kitti(args.to_kitti, args.frames);
-    core::VoxelMap scratch = map.EmptyMap();  // the Observation shares its grids
-    // The rule the map was built with, so the two sides weigh evidence alike.
-    integration::Integrator integrator(scratch, map.settings().integration);
-    for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
-    return {change::ObserveMap(scratch),
-            "scans " + source.Describe() + " (" + std::to_string(source.size()) + ", uncommitted)"};
-}
-
 // Saved change sets are the rows of the map's `change_sets` commits (`SELECT * FROM
 // change_sets`), every one of them, oldest first.
 void List(const DiffArgs& args) {
-    const store::MapStore map = OpenMap(args.map);
-    nlohmann::json sets = nlohmann::json::array();
-    for (const store::ProductRow& row : map.ProductHistory("change_sets")) {
-        nlohmann::json j = nlohmann::json::parse(row.json, nullptr, false);
-        if (!j.is_object()) {
-            throw FormatError(map.dir().string() + ": change set " + std::to_string(row.id) +
-                              " is damaged");
-        }
-        // The list keeps the keys it always had: the view's from_side/to_side as from/to.
-        nlohmann::json entry = {{"id", row.id}, {"commit", row.commit},
-                                {"created_utc", row.time_utc}};
-        for (const auto& [key, value] : j.items()) {
-            entry[key == "from_side" ? "from" : key == "to_side" ? "to" : key] = value;
-        }
-        sets.push_back(entry);
-    }
+    const nlohmann::json sets = pipeline::ChangeSetsJson(OpenMap(args.map));
     if (args.json) {
         std::cout << sets.dump(2) << "\n";
         return;
     }
     if (sets.empty()) std::cout << "no saved change sets (strata diff ... --save keeps one)\n";
     for (const nlohmann::json& r : sets) {
-        std::cout << r["id"] << "  " << r.value("created_utc", "") << "  "
-                  << r.value("from", "") << " -> " << r.value("to", "") << ": "
-                  << r.value("objects", 0) << " objects, +" << r.value("added_voxels", 0)
-                  << " / -" << r.value("removed_voxels", 0) << " voxels\n";
+        std::cout << r["id"] << "  " << r.value("created_utc", "") << "  " << r.value("from", "")
+                  << " -> " << r.value("to", "") << ": " << r.value("objects", 0) << " objects, +"
+                  << r.value("added_voxels", 0) << " / -" << r.value("removed_voxels", 0)
+                  << " voxels\n";
     }
 }
 
@@ -146,7 +113,13 @@ void Run(const DiffArgs& args) {
     change::MapObserver observer(map, query.region,
                                  static_cast<size_t>(args.memory_budget_mb * 1e6));
     const Side a = pipeline::ResolveSide(args.from.empty() ? "map" : args.from, map, observer);
-    const Side b = scans ? ObserveScans(args, map) : pipeline::ResolveSide(args.to, map, observer);
+    pipeline::ScanSpec to_scans;
+    to_scans.kitti = args.to_kitti;
+    to_scans.frames = args.frames;
+    to_scans.files = {args.to_scans.begin(), args.to_scans.end()};
+    to_scans.poses = args.poses;
+    const Side b = scans ? pipeline::ObserveScans(map, to_scans)
+                         : pipeline::ResolveSide(args.to, map, observer);
 
     const pipeline::DiffResult diff = pipeline::CompareSides(a, b, map, query);
     const change::ChangeSet& changes = diff.changes;
@@ -165,19 +138,8 @@ void Run(const DiffArgs& args) {
         PrintSummary(changes, a, b);
     }
     if (args.save) {
-        store::ProductCommit product;
-        product.kind = "change_sets";
-        product.rows.push_back(nlohmann::json{{"from_side", a.name},
-                                              {"to_side", b.name},
-                                              {"added_voxels", changes.added_voxels_total},
-                                              {"removed_voxels", changes.removed_voxels_total},
-                                              {"unknown_voxels", changes.unknown_voxels},
-                                              {"objects", changes.objects.size()},
-                                              {"report", nlohmann::json::parse(report)}}
-                                   .dump());
-        (void)map.CommitProduct(product);
-        (args.json ? std::cerr : std::cout)
-            << "saved as change set " << map.ProductRows("change_sets").back().id << "\n";
+        const int64_t id = pipeline::SaveChangeSet(map, a, b, diff);
+        (args.json ? std::cerr : std::cout) << "saved as change set " << id << "\n";
     }
 }
 

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <memory>
 
 namespace strata::tools {
 
@@ -33,6 +34,23 @@ void Progress::Draw() const {
     std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu %.1fs", label_.c_str(), filled,
                  "##############################", kWidth - filled, "", done_, total_, elapsed);
     std::fflush(stderr);
+}
+
+pipeline::ProgressCallback ProgressBars() {
+    struct Bars {
+        std::string stage;
+        std::unique_ptr<Progress> bar;
+    };
+    auto bars = std::make_shared<Bars>();  // std::function copies its target
+    return [bars](const pipeline::ProgressEvent& e) {
+        if (!bars->bar || e.stage != bars->stage) {
+            bars->bar.reset();  // ends the previous stage's line first
+            bars->stage = e.stage;
+            bars->bar = std::make_unique<Progress>(e.stage, e.total);
+        }
+        bars->bar->Update(e.done, e.total);
+        if (e.done >= e.total) bars->bar.reset();
+    };
 }
 
 }  // namespace strata::tools

@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <string>
 
+#include "strata/pipeline/Progress.hpp"
+
 namespace strata::tools {
 
 /// A one-line progress bar on stderr, shown only when stderr is a terminal.
@@ -27,5 +29,8 @@ private:
     bool enabled_;
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
+
+/// A pipeline use case's progress events drawn as bars: one per stage, ended when the stage is.
+[[nodiscard]] pipeline::ProgressCallback ProgressBars();
 
 }  // namespace strata::tools

@@ -1,11 +1,14 @@
 // strata register: where new scans or a session sit in a map (reports only; the map is read).
+#include "strata/pipeline/Register.hpp"
+
 #include <iostream>
 #include <memory>
 
 #include "Alignment.hpp"
 #include "Commands.hpp"
 #include "MapAccess.hpp"
-#include "strata/core/Error.hpp"
+#include "Progress.hpp"
+#include "ScanOptions.hpp"
 
 namespace strata::tools {
 
@@ -13,45 +16,29 @@ namespace {
 
 struct RegisterArgs {
     std::string map;
-    std::string kitti;
-    std::string frames;
-    std::vector<std::string> scans;
-    std::string poses;
-    int bin_fields = 0;  // --bin-fields; 0: from the name or size
+    pipeline::ScanSpec scans;
     std::string as_of;
     bool json = false;
     AlignArgs align;
 };
 
 void Run(const RegisterArgs& args) {
-    if (args.kitti.empty() == args.scans.empty()) {
-        throw InvalidArgumentError("give exactly one of --kitti SEQ or --scans FILES...");
-    }
+    args.scans.Validate();
     const store::MapStore map = OpenMap(args.map);
-    io::ReadOptions read_options;
-    read_options.origin = map.settings().origin;
-    read_options.bin_fields = args.bin_fields;
-    const ScanSource source =
-        args.kitti.empty()
-            ? ScanSource::Files({args.scans.begin(), args.scans.end()}, args.poses, read_options)
-            : ScanSource::Kitti(args.kitti, args.frames);
-    // A single scan without poses is registered as it is (its own frame); otherwise the scans
-    // form a session in the frame of their poses.
-    const SourceCloud cloud = ReadSourceCloud(source, args.poses.empty(), args.align);
-    const MapAlignment a = AlignToMap(map, SelectSnapshot(map, args.as_of), cloud,
-                                      InitialGuess(args.align), args.align);
+    pipeline::RegisterOptions options;
+    options.scans = args.scans;
+    options.as_of = args.as_of;
+    options.align = AlignRequestOf(args.align);
+    options.progress = ProgressBars();
+    const pipeline::Registration r = pipeline::RegisterScans(map, options);
     if (args.json) {
-        nlohmann::json j = AlignmentJson(a);
-        j["source"] = source.Describe();
-        j["scans"] = cloud.scans;
-        std::cout << j.dump(2) << "\n";
+        std::cout << pipeline::RegistrationJson(r).dump(2) << "\n";
     } else {
-        std::cout << args.map << " <- " << source.Describe() << " (" << cloud.scans
-                  << (cloud.single_scan ? " scan, its own frame" : " scans, session frame")
-                  << ")\n";
-        PrintAlignment(a, std::cout);
+        std::cout << args.map << " <- " << r.source << " (" << r.scans
+                  << (r.single_scan ? " scan, its own frame" : " scans, session frame") << ")\n";
+        PrintAlignment(r.alignment, std::cout);
     }
-    RequireAccepted(a, "alignment");
+    pipeline::RequireAccepted(r.alignment, "alignment");
 }
 
 }  // namespace
@@ -68,11 +55,7 @@ void RegisterRegister(CLI::App& app) {
         "Exits non-zero when the alignment is refused (small overlap, large residual,\n"
         "degenerate geometry, no convergence). The map is never changed.");
     cmd->add_option("MAP", args->map, "Map directory")->required();
-    cmd->add_option("--kitti", args->kitti, "KITTI/SemanticKITTI sequence folder");
-    cmd->add_option("--frames", args->frames, "Frame range A:B of the sequence (half-open)");
-    cmd->add_option("--scans", args->scans, "PCD, PLY, LAS, .bin or text files (.bz2 allowed)");
-    AddBinFieldsOption(*cmd, args->bin_fields);
-    cmd->add_option("--poses", args->poses, "Pose file for --scans (KITTI 3x4 or TUM), by index");
+    AddScanOptions(*cmd, args->scans);
     cmd->add_option("--as-of", args->as_of, "Align to the map as of this session");
     cmd->add_flag("--json", args->json, "Print the result as JSON");
     AddAlignOptions(*cmd, args->align);

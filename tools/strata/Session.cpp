@@ -5,19 +5,14 @@
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
+#include "strata/pipeline/Sessions.hpp"
 
 namespace strata::tools {
 
 namespace {
 
 void List(const std::string& dir, bool json) {
-    const store::MapStore map = OpenMap(dir);
-    nlohmann::json j = nlohmann::json::array();
-    for (const auto& [s, removed] : map.SessionHistory()) {
-        j.push_back({{"id", s.id}, {"name", s.name}, {"source", s.source}, {"scans", s.scans},
-                     {"points", s.points}, {"start_utc", s.start_utc}, {"end_utc", s.end_utc},
-                     {"commit", s.commit}, {"removed_commit", removed}});
-    }
+    const nlohmann::json j = pipeline::SessionHistoryJson(OpenMap(dir));
     if (json) {
         std::cout << j.dump(2) << "\n";
         return;
@@ -31,10 +26,9 @@ void List(const std::string& dir, bool json) {
 
 void Remove(const std::string& dir, const std::string& session) {
     store::MapStore map = store::MapStore::Open(dir, store::MapStore::Access::kWrite);
-    const int64_t id = map.FindSession(session);
-    const int64_t commit = map.RemoveSession(id);
-    std::cout << "removed session " << id << " in commit " << commit << " (still readable with "
-              << "--as-of " << id << ")\n";
+    const pipeline::RemovedSession removed = pipeline::RemoveSession(map, session);
+    std::cout << "removed session " << removed.id << " in commit " << removed.commit
+              << " (still readable with --as-of " << removed.id << ")\n";
 }
 
 }  // namespace
@@ -51,8 +45,9 @@ void RegisterSession(CLI::App& app) {
 
     auto session = std::make_shared<std::string>();
     CLI::App* rm = cmd->add_subcommand(
-        "rm", "Remove a session: its layers leave the map and the fused grids are rebuilt from "
-              "the remaining sessions");
+        "rm",
+        "Remove a session: its layers leave the map and the fused grids are rebuilt from "
+        "the remaining sessions");
     rm->footer("Example:\n  strata session rm city.strata 3");
     rm->add_option("MAP", *map, "Map directory")->required();
     rm->add_option("SESSION", *session, "Session id or name")->required();

@@ -29,25 +29,6 @@ struct VehiclesArgs {
     double picture_height_m = 2.5;
 };
 
-// One row of the vehicles view (docs/store.md, "Products"; meaning of each key: docs/vehicles.md).
-std::string VehicleRow(const vehicles::Vehicle& v) {
-    const Eigen::Vector3d c = v.Center(), size = v.Size();
-    return nlohmann::json{{"vehicle_id", v.id},
-                          {"center_x", c.x()},
-                          {"center_y", c.y()},
-                          {"center_z", c.z()},
-                          {"length_m", size.x()},
-                          {"width_m", size.y()},
-                          {"height_m", size.z()},
-                          {"yaw_deg", v.YawDeg()},
-                          {"source", vehicles::SourceName(v.source)},
-                          {"voxels", v.voxels},
-                          {"cleared_voxels", v.cleared_voxels},
-                          {"refilled_cells", v.refilled_cells},
-                          {"refused_cells", v.refused_cells}}
-        .dump();
-}
-
 // Median ground height of the vehicles (0 without any): where the picture's cut is measured from.
 double GroundLevel(const vehicles::VehicleResult& result) {
     std::vector<double> z;
@@ -87,31 +68,24 @@ void Run(VehiclesArgs& args) {
     store::MapStore map =
         OpenMap(args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
     const store::Snapshot snapshot = SelectSnapshot(map, args.as_of);
-    core::VoxelMap voxels = map.LoadMap(snapshot);
-    const std::vector<Eigen::Vector3d> origins = pipeline::SensorOrigins(map, snapshot);
-    const core::VoxelMap before = args.png.empty() ? core::VoxelMap{} : voxels.DeepCopy();
-    const vehicles::VehicleResult result = vehicles::ClearVehicles(voxels, origins, args.config);
+    pipeline::VehiclesOutcome outcome = pipeline::ClearVehicles(map, snapshot, args.config);
+    const vehicles::VehicleResult& result = outcome.result;
 
     if (!args.png.empty()) {
-        vehicles::WriteVehiclesPng(before, voxels, result, args.png,
+        vehicles::WriteVehiclesPng(map.LoadMap(snapshot), outcome.cleaned, result, args.png,
                                    GroundLevel(result) + args.picture_height_m);
     }
     if (!args.vdb.empty()) WriteGridsFile(vehicles::VehicleGrids(result), args.vdb);
     if (args.json) {
-        std::cout << vehicles::VehiclesJson(result, voxels.origin);
+        std::cout << vehicles::VehiclesJson(result, outcome.cleaned.origin);
     } else {
         PrintSummary(result, map);
     }
     if (save) {
-        store::ProductCommit product;
-        product.kind = "vehicles";
-        product.grids = vehicles::VehicleGrids(result);
-        product.edited = &voxels;
-        for (const vehicles::Vehicle& v : result.vehicles) product.rows.push_back(VehicleRow(v));
-        const int64_t commit = map.CommitProduct(product);
+        const int64_t commit = pipeline::StoreVehicles(map, outcome);
         (args.json ? std::cerr : std::cout)
             << "stored the cleaned map, the vehicle_cleared and vehicle_refilled grids and "
-            << product.rows.size() << " vehicles (commit " << commit << ")\n";
+            << result.vehicles.size() << " vehicles (commit " << commit << ")\n";
     }
 }
 

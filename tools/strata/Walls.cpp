@@ -1,4 +1,6 @@
 // strata walls: walls and their slant angles from the column statistics of a map.
+#include "strata/pipeline/Walls.hpp"
+
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -27,26 +29,6 @@ struct WallsArgs {
     std::string columns_vdb;
     bool no_save = false;
 };
-
-// One row of the walls view (docs/store.md, "Products"; meaning of each key: docs/walls.md).
-std::string WallRow(const walls::Wall& w) {
-    return nlohmann::json{{"wall_id", w.id},
-                          {"center_x", w.centroid.x()},
-                          {"center_y", w.centroid.y()},
-                          {"center_z", w.centroid.z()},
-                          {"normal_x", w.normal.x()},
-                          {"normal_y", w.normal.y()},
-                          {"normal_z", w.normal.z()},
-                          {"slant_deg", w.slant_deg},
-                          {"uncertainty_deg", w.uncertainty_deg},
-                          {"lean_azimuth_deg", w.lean_azimuth_deg},
-                          {"area_m2", w.area_m2},
-                          {"rms_m", w.rms_m},
-                          {"length_m", w.length_m},
-                          {"height_m", w.height_m},
-                          {"inliers", w.inliers}}
-        .dump();
-}
 
 void PrintSummary(const walls::WallResult& result, const store::MapStore& map) {
     const walls::WallStats& s = result.stats;
@@ -82,12 +64,15 @@ void Run(const WallsArgs& args) {
     const bool save = !args.no_save && args.as_of.empty();
     store::MapStore map =
         OpenMap(args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    const core::VoxelMap voxels = map.LoadMap(SelectSnapshot(map, args.as_of));
-    const walls::WallResult result = walls::FindWalls(voxels, args.config);
+    const pipeline::WallsOutcome outcome =
+        pipeline::FindWalls(map, SelectSnapshot(map, args.as_of), args.config);
+    const core::VoxelMap& voxels = outcome.map;
+    const walls::WallResult& result = outcome.result;
 
     if (!args.columns_csv.empty() || !args.columns_png.empty() || !args.columns_vdb.empty()) {
         const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(voxels);
-        if (!args.columns_csv.empty()) WriteTextFile(args.columns_csv, cols.ToCsv(voxels.voxel_size));
+        if (!args.columns_csv.empty())
+            WriteTextFile(args.columns_csv, cols.ToCsv(voxels.voxel_size));
         if (!args.columns_png.empty()) {
             columns::WriteColumnPng(cols, voxels.voxel_size, args.columns_png);
         }
@@ -104,13 +89,9 @@ void Run(const WallsArgs& args) {
         PrintSummary(result, map);
     }
     if (save) {
-        store::ProductCommit product;
-        product.kind = "walls";
-        product.grids = walls::WallGrids(result);
-        for (const walls::Wall& w : result.walls) product.rows.push_back(WallRow(w));
-        const int64_t commit = map.CommitProduct(product);
+        const int64_t commit = pipeline::StoreWalls(map, outcome);
         (args.json ? std::cerr : std::cout)
-            << "stored slant_deg and wall_id grids and " << product.rows.size()
+            << "stored slant_deg and wall_id grids and " << result.walls.size()
             << " walls in the map (commit " << commit << ")\n";
     }
 }

@@ -21,6 +21,17 @@ struct AlignOptions {
     registration::RegistrationConfig config;
 };
 
+/// @brief An alignment asked for: how, and from which guess of T_map_source.
+struct AlignRequest {
+    AlignOptions options;
+    Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+};
+
+/// @brief The guess `--init x,y,z,yaw_deg` (metres, degrees) as T_map_source; the identity when
+/// `xyz_yaw_deg` is empty.
+/// @throw InvalidArgumentError unless it holds 4 finite values (or none).
+[[nodiscard]] Eigen::Isometry3d GuessFromXyzYaw(const std::vector<double>& xyz_yaw_deg);
+
 /// @brief What is aligned: one scan in its own frame, or the scans of a session in the session
 /// frame.
 struct SourceCloud {
@@ -29,6 +40,7 @@ struct SourceCloud {
     bool single_scan = false;  ///< points in the scan's sensor frame: range limits apply
 };
 
+/// @brief An alignment's result, the size of the map region it used and its times.
 struct MapAlignment {
     registration::RegistrationResult result;
     size_t map_points = 0;    ///< occupied voxels in the region read

@@ -1,10 +1,13 @@
 #pragma once
 // Change queries against a stored map (docs/change.md): `strata diff` and Python's Map.diff.
 
+#include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "strata/change/ChangeDetection.hpp"
 #include "strata/change/MapObserver.hpp"
+#include "strata/pipeline/ScanSource.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::pipeline {
@@ -31,5 +34,21 @@ struct DiffResult {
 /// and thresholds) and writes the report.
 [[nodiscard]] DiffResult CompareSides(const DiffSide& a, const DiffSide& b,
                                       const store::MapStore& map, const change::ChangeQuery& query);
+
+/// @brief Scans not yet integrated as a side: integrated in memory with the map's voxel size,
+/// origin and integration rule (so both sides weigh evidence alike); the map is only read.
+/// @throw the errors of ScanSource::Open, its readers and the integration.
+[[nodiscard]] DiffSide ObserveScans(const store::MapStore& map, const ScanSpec& scans);
+
+/// @brief Keeps a comparison in the map's catalog as one `change_sets` commit (a row of the
+/// `change_sets` view: from_side, to_side, the counts and the report); returns the row's id.
+/// @throw InvalidArgumentError when `map` is not open for writing; the store's errors.
+int64_t SaveChangeSet(store::MapStore& map, const DiffSide& a, const DiffSide& b,
+                      const DiffResult& diff);
+
+/// @brief Every saved change set, oldest first: id, commit, created_utc, from, to and the
+/// counts and report as saved.
+/// @throw FormatError naming the row when a row is damaged.
+[[nodiscard]] nlohmann::json ChangeSetsJson(const store::MapStore& map);
 
 }  // namespace strata::pipeline

@@ -19,4 +19,9 @@ namespace strata::pipeline {
 /// or a name) when it is not empty (NotFoundError listing the sessions otherwise).
 [[nodiscard]] store::Snapshot SelectSnapshot(const store::MapStore& map, const std::string& as_of);
 
+/// @brief Checks that products computed from the snapshot of `commit` may be stored: `map` is
+/// open for writing and `commit` is its newest commit (`what` names the products).
+/// @throw InvalidArgumentError otherwise, saying which.
+void RequireNewest(const store::MapStore& map, int64_t commit, const std::string& what);
+
 }  // namespace strata::pipeline

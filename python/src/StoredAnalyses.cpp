@@ -1,0 +1,226 @@
+// The analyses and registrations of strata.Map: each goes through the pipeline use case the
+// program runs (strata diff, vehicles, walls, register, localize), answered with the keys of
+// the program's JSON report plus arrays.
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <memory>
+
+#include "Analyses.hpp"
+#include "Arrays.hpp"
+#include "StoredMap.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/core/Labels.hpp"
+#include "strata/core/Region.hpp"
+#include "strata/pipeline/Alignment.hpp"
+#include "strata/pipeline/Diff.hpp"
+#include "strata/pipeline/Localize.hpp"
+#include "strata/pipeline/MapAccess.hpp"
+#include "strata/pipeline/Vehicles.hpp"
+#include "strata/pipeline/Walls.hpp"
+#include "strata/vehicles/VehicleReport.hpp"
+
+namespace strata::python {
+
+namespace {
+
+using store::MapStore;
+
+/// T_map_source from a (4, 4) / (3, 4) pose or (x, y, z, yaw_deg).
+Eigen::Isometry3d GuessFrom(const py::object& init) {
+    const py::array a = py::array::ensure(init);
+    if (a && a.ndim() == 1 && a.shape(0) == 4) {
+        const auto values = py::array_t<double, py::array::forcecast>(a);
+        const auto v = values.unchecked<1>();
+        if (!std::isfinite(v(0) + v(1) + v(2) + v(3))) {
+            throw InvalidArgumentError("init must be finite");
+        }
+        return registration::PoseFromXyzYaw(v(0), v(1), v(2), v(3));
+    }
+    if (!a) throw InvalidArgumentError("init must be a 4x4 pose or (x, y, z, yaw_deg)");
+    return PoseFromArray(a, "init");
+}
+
+/// Products are stored for the newest map of a map open for writing: checked before the work.
+void CheckSave(const MapStore& store, const std::string& as_of, const std::string& what) {
+    if (!as_of.empty()) {
+        throw InvalidArgumentError("save=True stores the " + what +
+                                   " of the newest map; as_of reads an older state (give one "
+                                   "of the two)");
+    }
+    if (!store.writable()) {
+        throw InvalidArgumentError(store.dir().string() +
+                                   " is open read-only; open it with read_only=False to store " +
+                                   "its " + what);
+    }
+}
+
+py::dict Register(const StoredMap& m, const py::array& points, const py::object& init,
+                  const std::string& as_of, double margin, double min_range, double max_range,
+                  double min_overlap, double max_rmse) {
+    pipeline::SourceCloud cloud;
+    cloud.points = PointsFromArray(points);
+    cloud.scans = 1;
+    cloud.single_scan = true;
+    pipeline::AlignOptions options;
+    options.margin_m = margin;
+    options.min_range_m = min_range;
+    options.max_range_m = max_range;
+    options.config.min_overlap = min_overlap;
+    options.config.max_rmse_m = max_rmse;
+    const Eigen::Isometry3d guess =
+        init.is_none() ? Eigen::Isometry3d::Identity() : GuessFrom(init);
+    const MapStore& store = m.Get();
+    pipeline::MapAlignment a;
+    {
+        py::gil_scoped_release release;
+        a = pipeline::AlignToMap(store, pipeline::SelectSnapshot(store, as_of), cloud, guess,
+                                 options);
+    }
+    py::dict report = ParseJson(pipeline::AlignmentJson(a).dump());
+    report["pose"] = MatrixToArray(a.result.T_map_source.matrix());
+    return report;
+}
+
+py::dict Localize(const StoredMap& m, const py::array& points, int floor, const py::object& init,
+                  double l1, double l2, double min_range, double max_range,
+                  const py::object& min_overlap, const py::object& max_rmse) {
+    const std::vector<Eigen::Vector3d> scan = PointsFromArray(points);
+    pipeline::LocalizeOptions options;
+    options.floor = floor;
+    options.slice.l1_m = l1;
+    options.slice.l2_m = l2;
+    if (!init.is_none()) options.guess = GuessFrom(init);
+    options.align.min_range_m = min_range;
+    options.align.max_range_m = max_range;
+    if (!min_overlap.is_none()) options.align.config.min_overlap = min_overlap.cast<double>();
+    if (!max_rmse.is_none()) options.align.config.max_rmse_m = max_rmse.cast<double>();
+    options.Validate();
+    const MapStore& store = m.Get();
+    pipeline::Localization l;
+    {
+        py::gil_scoped_release release;
+        l = pipeline::Localize(store, scan, options);
+    }
+    py::dict report = ParseJson(pipeline::LocalizationJson(l).dump());
+    report["pose"] = MatrixToArray(l.alignment.result.T_map_source.matrix());
+    return report;
+}
+
+py::dict Walls(const StoredMap& m, const std::string& as_of, bool save, const py::kwargs& options) {
+    const walls::WallConfig config = WallConfigFrom(options);
+    MapStore& store = m.Get();
+    if (save) CheckSave(store, as_of, "walls");
+    pipeline::WallsOutcome outcome;
+    int64_t commit = 0;
+    {
+        py::gil_scoped_release release;
+        outcome = pipeline::FindWalls(store, pipeline::SelectSnapshot(store, as_of), config);
+        if (save) commit = pipeline::StoreWalls(store, outcome);
+    }
+    py::dict report = WallsReport(outcome.map, outcome.result, config);
+    if (save) report["commit"] = commit;
+    return report;
+}
+
+py::dict Vehicles(const StoredMap& m, const std::string& as_of, const std::string& source,
+                  bool ray_check, bool refill, bool save) {
+    vehicles::VehicleConfig config;
+    config.source = vehicles::SourceFromName(source);
+    config.ray_check = ray_check;
+    config.refill = refill;
+    MapStore& store = m.Get();
+    if (save) CheckSave(store, as_of, "vehicles");
+    auto outcome = std::make_shared<pipeline::VehiclesOutcome>();
+    {
+        py::gil_scoped_release release;
+        *outcome = pipeline::ClearVehicles(store, pipeline::SelectSnapshot(store, as_of), config);
+    }
+    py::dict report = ParseJson(vehicles::VehiclesJson(outcome->result, outcome->cleaned.origin));
+    if (save) {
+        // The cleaned map's leaves move into the store: the caller reads it back from there.
+        int64_t commit = 0;
+        {
+            py::gil_scoped_release release;
+            commit = pipeline::StoreVehicles(store, *outcome);
+        }
+        report["commit"] = commit;
+        return report;
+    }
+    MemoryMap cleaned;
+    cleaned.map = std::shared_ptr<core::VoxelMap>(outcome, &outcome->cleaned);
+    cleaned.config = m.config;
+    cleaned.read_only = true;
+    report["map"] = py::cast(std::move(cleaned));
+    return report;
+}
+
+/// Centres of the active voxels of a change mask, (M, 3) in the map frame.
+py::array_t<double> Centers(const openvdb::BoolGrid::Ptr& mask, const core::VoxelMap& frame) {
+    std::vector<Eigen::Vector3d> centers;
+    if (mask) {
+        for (auto it = mask->cbeginValueOn(); it; ++it) {
+            centers.push_back(frame.VoxelCenter(it.getCoord()));
+        }
+    }
+    return PointsToArray(centers);
+}
+
+py::dict Diff(const StoredMap& m, const std::string& from, const std::string& to,
+              const py::object& region, const std::string& class_name, size_t min_voxels, int gap,
+              int tolerance, int margin, int grow, int support) {
+    change::ChangeQuery query;
+    if (!region.is_none()) {
+        std::string text = py::isinstance<py::str>(region) ? region.cast<std::string>() : "";
+        if (text.empty()) {
+            for (const py::handle v : region) {
+                text += (text.empty() ? "" : ",") + py::str(v).cast<std::string>();
+            }
+        }
+        query.region = core::Region::Parse(text);
+    }
+    if (!class_name.empty()) query.class_filter = core::ClassFromName(class_name);
+    if (min_voxels < 1) throw InvalidArgumentError("min_voxels must be at least 1");
+    if (gap < 0 || tolerance < 0 || margin < 0 || grow < 0 || support < 0) {
+        throw InvalidArgumentError("gap, tolerance, margin, grow and support must be >= 0");
+    }
+    query.min_voxels = min_voxels;
+    query.gap_voxels = gap;
+    query.surface_tolerance_voxels = tolerance;
+    query.observed_margin_voxels = margin;
+    query.grow_voxels = grow;
+    query.support_depth_voxels = support;
+    const MapStore& store = m.Get();
+    pipeline::DiffResult result;
+    {
+        py::gil_scoped_release release;
+        change::MapObserver observer(store, query.region);
+        const pipeline::DiffSide a = pipeline::ResolveSide(from, store, observer);
+        const pipeline::DiffSide b = pipeline::ResolveSide(to, store, observer);
+        result = pipeline::CompareSides(a, b, store, query);
+    }
+    py::dict report = ParseJson(result.report);
+    const core::VoxelMap frame = store.EmptyMap();
+    report["added"] = Centers(result.changes.added, frame);
+    report["removed"] = Centers(result.changes.removed, frame);
+    return report;
+}
+
+}  // namespace
+
+void AddStoredAnalyses(py::class_<StoredMap>& cls) {
+    cls.def("diff", &Diff, py::arg("from_side"), py::arg("to_side"), py::arg("region"),
+            py::arg("class_name"), py::arg("min_voxels"), py::arg("gap"), py::arg("tolerance"),
+            py::arg("margin"), py::arg("grow"), py::arg("support"))
+        .def("vehicles", &Vehicles, py::arg("as_of"), py::arg("source"), py::arg("ray_check"),
+             py::arg("refill"), py::arg("save"))
+        .def("walls", &Walls, py::arg("as_of"), py::arg("save"))
+        .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
+             py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),
+             py::arg("max_rmse"))
+        .def("localize", &Localize, py::arg("points"), py::arg("floor"), py::arg("init"),
+             py::arg("l1"), py::arg("l2"), py::arg("min_range"), py::arg("max_range"),
+             py::arg("min_overlap"), py::arg("max_rmse"));
+}
+
+}  // namespace strata::python

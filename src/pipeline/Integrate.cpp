@@ -1,0 +1,91 @@
+#include "strata/pipeline/Integrate.hpp"
+
+#include <chrono>
+#include <optional>
+
+#include "strata/core/Error.hpp"
+#include "strata/pipeline/NewSession.hpp"
+#include "strata/pipeline/Register.hpp"
+
+namespace strata::pipeline {
+
+namespace {
+
+// Reads, aligns and integrates into an open map; commits only when every scan went in.
+IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOptions& options) {
+    store::MapStore& map = opened.map;
+    const ScanSource source = ScanSource::Open(scans, map.settings().origin);
+    IntegrateResult result;
+    result.created = opened.created;
+    store::SessionOptions session;
+    session.name = options.name;
+    session.source = source.Describe();
+    session.memory_budget_bytes = static_cast<size_t>(options.memory_budget_mb * 1e6);
+    if (options.align) {
+        // Aligned before anything is written: a refusal commits nothing.
+        const SourceCloud cloud =
+            ReadSourceCloud(source, false, options.align->options, options.progress);
+        const MapAlignment a =
+            AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
+        if (options.on_aligned) options.on_aligned(a);
+        RequireAccepted(a, "--align: the alignment of " + source.Describe());
+        session.alignment = a.result.T_map_source.matrix();
+        session.notes = "alignment " + AlignmentJson(a).dump();
+        result.alignment = a;
+    }
+    if (options.on_start) options.on_start({map, source, opened.created, opened.rule});
+
+    const auto start = std::chrono::steady_clock::now();
+    NewSession writer(map, opened.rule, session);
+    const char* stage = "integrating";
+    ReportProgress(options.progress, stage, 0, source.size());
+    for (size_t i = 0; i < source.size(); ++i) {
+        (void)writer.Integrate(source.Read(i));  // reader errors name their file already
+        ReportProgress(options.progress, stage, i + 1, source.size());
+    }
+    result.session = writer.Commit();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.stats = writer.stats();
+    result.map_tiles = map.Latest().tiles.size();
+    return result;
+}
+
+}  // namespace
+
+void IntegrateOptions::Validate() const {
+    map.rule.Validate();
+    if (!(memory_budget_mb >= 0.0)) throw InvalidArgumentError("--memory-budget must be >= 0");
+}
+
+IntegrateResult IntegrateSession(const std::filesystem::path& dir, const ScanSpec& scans,
+                                 const IntegrateOptions& options) {
+    scans.Validate();
+    options.Validate();
+    const bool exists = store::MapStore::IsMap(dir);
+    if (options.align && !exists) {
+        throw InvalidArgumentError("--align needs a map to align to; " + dir.string() +
+                                   " does not exist yet (integrate the first session without "
+                                   "--align)");
+    }
+    MapRequest request = options.map;
+    if (request.georeference_from.empty() && !scans.files.empty()) {
+        request.georeference_from = scans.files.front();
+    }
+    std::optional<OpenedMap> opened;
+    opened.emplace(OpenOrCreateMap(dir, request));
+    const bool created = opened->created;
+    try {
+        return Run(*opened, scans, options);
+    } catch (...) {
+        // A map this call created holds nothing else: leave no empty map behind.
+        if (created) {
+            opened.reset();  // closes the map first
+            std::error_code ignored;
+            std::filesystem::remove_all(dir, ignored);
+        }
+        throw;
+    }
+}
+
+}  // namespace strata::pipeline

@@ -1,0 +1,49 @@
+#include "strata/pipeline/Walls.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "strata/pipeline/MapAccess.hpp"
+#include "strata/walls/WallReport.hpp"
+
+namespace strata::pipeline {
+
+WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
+                       const walls::WallConfig& config) {
+    config.Validate();
+    WallsOutcome outcome;
+    outcome.map = map.LoadMap(snapshot);
+    outcome.commit = snapshot.commit;
+    outcome.result = walls::FindWalls(outcome.map, config);
+    return outcome;
+}
+
+std::string WallRow(const walls::Wall& w) {
+    return nlohmann::json{{"wall_id", w.id},
+                          {"center_x", w.centroid.x()},
+                          {"center_y", w.centroid.y()},
+                          {"center_z", w.centroid.z()},
+                          {"normal_x", w.normal.x()},
+                          {"normal_y", w.normal.y()},
+                          {"normal_z", w.normal.z()},
+                          {"slant_deg", w.slant_deg},
+                          {"uncertainty_deg", w.uncertainty_deg},
+                          {"lean_azimuth_deg", w.lean_azimuth_deg},
+                          {"area_m2", w.area_m2},
+                          {"rms_m", w.rms_m},
+                          {"length_m", w.length_m},
+                          {"height_m", w.height_m},
+                          {"inliers", w.inliers}}
+        .dump();
+}
+
+int64_t StoreWalls(store::MapStore& map, const WallsOutcome& outcome) {
+    RequireNewest(map, outcome.commit, "walls");
+    const walls::WallResult& result = outcome.result;
+    store::ProductCommit product;
+    product.kind = "walls";
+    product.grids = walls::WallGrids(result);
+    for (const walls::Wall& w : result.walls) product.rows.push_back(WallRow(w));
+    return map.CommitProduct(product);
+}
+
+}  // namespace strata::pipeline

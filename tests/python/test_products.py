@@ -1,0 +1,94 @@
+"""Map.walls(save=True) and Map.vehicles(save=True) store what `strata walls` and `strata
+vehicles` store on the same map: the same commits, rows and map; bad input is refused before
+anything is read or written."""
+import json
+import shutil
+import sqlite3
+
+import numpy as np
+import pytest
+
+import strata
+from conftest import run_strata, tree_digest
+
+EVERYWHERE = ([-1e4] * 3, [1e4] * 3)
+
+
+def rows(path, kind):
+    """Every row of the map's `kind` view (`SELECT * FROM walls`), read without writing."""
+    with sqlite3.connect(f"file:{path}/catalog.sqlite?mode=ro", uri=True) as catalog:
+        return catalog.execute(f"SELECT * FROM {kind} ORDER BY id").fetchall()
+
+
+def without_times(report):
+    report.pop("seconds", None)
+    if "stats" in report:
+        report["stats"] = {k: v for k, v in report["stats"].items() if "seconds" not in k}
+    return report
+
+
+def info(path):
+    """`strata info --json` less what differs between two copies: the path and file sizes that
+    depend on SQLite's files."""
+    out = run_strata("info", path, "--json").stdout
+    d = json.loads(out[out.index("{"):])
+    for key in ("map", "disk_bytes"):
+        d.pop(key)
+    d["bytes"].pop("catalog")
+    return d
+
+
+@pytest.fixture
+def two_copies(tmp_path, street_sequence):
+    """The simulated street integrated by the program, twice: one copy for the program, one
+    for the module."""
+    run_strata("integrate", tmp_path / "theirs", "--kitti", street_sequence)
+    shutil.copytree(tmp_path / "theirs", tmp_path / "ours")
+    return tmp_path / "theirs", tmp_path / "ours"
+
+
+def test_saved_walls_and_vehicles_equal_what_the_program_stores(two_copies):
+    theirs, ours = two_copies
+    walls_cli = without_times(json.loads(run_strata("walls", theirs, "--json").stdout))
+    vehicles_cli = without_times(json.loads(run_strata("vehicles", theirs, "--json").stdout))
+    with strata.Map.open(ours) as m:
+        walls = m.walls(save=True)
+        vehicles = m.vehicles(save=True)
+        cleaned = vehicles.pop("map").voxels(*EVERYWHERE)
+    with strata.Map.open(theirs, read_only=True) as m:
+        expected = m.snapshot().voxels(*EVERYWHERE)
+    assert vehicles.pop("commit") == walls.pop("commit") + 1  # one commit each
+    walls.pop("voxels")
+    assert without_times(walls) == walls_cli
+    assert without_times(vehicles) == vehicles_cli
+    assert len(walls["walls"]) >= 5 and len(vehicles["vehicles"]) >= 3
+    for kind in ("walls", "vehicles"):
+        assert rows(ours, kind) == rows(theirs, kind)
+        assert len(rows(ours, kind)) == len((walls if kind == "walls" else vehicles)[kind])
+    for key in expected:  # the cleaned map as stored: the program's, voxel for voxel
+        np.testing.assert_array_equal(cleaned[key], expected[key], err_msg=key)
+    assert info(ours) == info(theirs)  # the newest commit, voxels by class, bytes by kind
+    assert sorted(p.name for p in (ours / "tiles").rglob("*.vdb")) == \
+        sorted(p.name for p in (theirs / "tiles").rglob("*.vdb"))
+
+
+def test_saving_is_refused_before_any_work_and_leaves_the_map(two_copies):
+    _, path = two_copies
+    before = tree_digest(path)
+    with strata.Map.open(path, read_only=True) as m:
+        with pytest.raises(strata.InvalidArgumentError, match="read-only.*store its walls"):
+            m.walls(save=True)
+        with pytest.raises(strata.InvalidArgumentError, match="read-only.*store its vehicles"):
+            m.vehicles(save=True)
+        assert "map" in m.vehicles() and "commit" not in m.walls()  # reading needs no writer
+    with strata.Map.open(path) as m:
+        first = m.sessions()[0]["name"]
+        with pytest.raises(strata.InvalidArgumentError, match="as_of reads an older state"):
+            m.walls(as_of=first, save=True)
+        with pytest.raises(strata.InvalidArgumentError, match="as_of reads an older state"):
+            m.vehicles(as_of=first, save=True)
+        with pytest.raises(strata.InvalidArgumentError, match="unknown wall option 'windw_m'"):
+            m.walls(save=True, windw_m=2.0)
+        with pytest.raises(strata.InvalidArgumentError, match="source"):
+            m.vehicles(save=True, source="radar")
+    assert tree_digest(path) == before

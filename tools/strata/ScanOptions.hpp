@@ -1,0 +1,16 @@
+#pragma once
+// Shared by integrate and register: the options that name the scans to read.
+
+#include <CLI/CLI.hpp>
+
+#include "strata/pipeline/ScanSource.hpp"
+
+namespace strata::tools {
+
+/// Adds --bin-fields to a command that reads --scans: float32 values per point of raw .bin scans.
+void AddBinFieldsOption(CLI::App& cmd, int& bin_fields);
+
+/// Adds --kitti, --frames, --scans, --bin-fields and --poses, filling `spec`.
+void AddScanOptions(CLI::App& cmd, pipeline::ScanSpec& spec);
+
+}  // namespace strata::tools
