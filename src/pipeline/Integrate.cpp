@@ -1,10 +1,13 @@
 #include "strata/pipeline/Integrate.hpp"
 
 #include <chrono>
+#include <iomanip>
+#include <sstream>
 #include <optional>
 
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/NewSession.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 #include "strata/pipeline/Register.hpp"
 
 namespace strata::pipeline {
@@ -51,6 +54,91 @@ IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOpt
     return result;
 }
 
+// A 4x4 transform as text and back, every digit kept (for the other ranks).
+std::string AlignmentText(const Eigen::Matrix4d& m) {
+    std::ostringstream os;
+    os << std::setprecision(17);
+    for (int i = 0; i < 16; ++i) os << m.data()[i] << ' ';
+    return os.str();
+}
+
+Eigen::Matrix4d AlignmentFromText(const std::string& text) {
+    std::istringstream is(text);
+    Eigen::Matrix4d m;
+    for (int i = 0; i < 16; ++i) is >> m.data()[i];
+    if (!is) throw FormatError("the session's alignment from rank 0 is not 16 numbers");
+    return m;
+}
+
+// The session on several ranks: rank 0 opens (or creates) the map for writing and aligns the
+// session, the others open it for reading once it has; then every rank integrates its share.
+IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& request,
+                           const ScanSpec& scans, const IntegrateOptions& options) {
+    const Ranks& ranks = *options.ranks;
+    std::optional<OpenedMap> opened;
+    OnEveryRank(ranks, [&] {
+        if (ranks.root()) opened.emplace(OpenOrCreateMap(dir, request));
+    });
+    const bool created = ranks.Broadcast(ranks.root() && opened->created ? "1" : "0") == "1";
+    try {
+        OnEveryRank(ranks, [&] {
+            if (ranks.root()) return;
+            store::MapStore map = store::MapStore::Open(dir, store::MapStore::Access::kRead);
+            const integration::IntegrationConfig rule =
+                ResolveRule(map.settings(), dir.string(), request.rule);
+            opened.emplace(OpenedMap{std::move(map), created, rule});
+        });
+        store::MapStore& map = opened->map;
+        std::optional<ScanSource> source;
+        OnEveryRank(ranks, [&] { source.emplace(ScanSource::Open(scans, map.settings().origin)); });
+        IntegrateResult result;
+        result.created = created;
+        store::SessionOptions session;
+        session.name = options.name;
+        session.source = source->Describe();
+        session.memory_budget_bytes = static_cast<size_t>(options.memory_budget_mb * 1e6);
+        // Rank 0 aligns; every rank integrates with its transform.
+        OnEveryRank(ranks, [&] {
+            if (!ranks.root() || !options.align) return;
+            const SourceCloud cloud =
+                ReadSourceCloud(*source, false, options.align->options, options.progress);
+            const MapAlignment a =
+                AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
+            if (options.on_aligned) options.on_aligned(a);
+            RequireAccepted(a, "--align: the alignment of " + source->Describe());
+            session.alignment = a.result.T_map_source.matrix();
+            session.notes = "alignment " + AlignmentJson(a).dump();
+            result.alignment = a;
+        });
+        const std::string alignment = ranks.Broadcast(AlignmentText(session.alignment));
+        session.alignment = AlignmentFromText(alignment);
+        if (ranks.root() && options.on_start) {
+            options.on_start({map, *source, created, opened->rule});
+        }
+        const auto start = std::chrono::steady_clock::now();
+        const char* stage = "integrating";
+        if (ranks.root()) ReportProgress(options.progress, stage, 0, source->size());
+        const RankedSessionResult r = IntegrateOnRanks(
+            map, source->size(), [&](size_t i) { return source->Read(i); }, opened->rule,
+            session, ranks,
+            [&](size_t done) { ReportProgress(options.progress, stage, done, source->size()); });
+        result.session = r.session;
+        result.stats = r.stats;
+        result.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.map_tiles = map.Latest().tiles.size();
+        return result;
+    } catch (...) {
+        // A map this command created holds nothing else: rank 0 removes it.
+        if (created && ranks.root()) {
+            opened.reset();
+            std::error_code ignored;
+            std::filesystem::remove_all(dir, ignored);
+        }
+        throw;
+    }
+}
+
 }  // namespace
 
 void IntegrateOptions::Validate() const {
@@ -71,6 +159,9 @@ IntegrateResult IntegrateSession(const std::filesystem::path& dir, const ScanSpe
     MapRequest request = options.map;
     if (request.georeference_from.empty() && !scans.files.empty()) {
         request.georeference_from = scans.files.front();
+    }
+    if (options.ranks && options.ranks->size() > 1) {
+        return RunOnRanks(dir, request, scans, options);
     }
     std::optional<OpenedMap> opened;
     opened.emplace(OpenOrCreateMap(dir, request));

@@ -2,6 +2,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "strata/pipeline/Ranks.hpp"
+
 // Each subcommand lives in its own file and registers itself on the top-level app.
 // Registration adds options and a callback; the callback does the work and throws on failure.
 namespace strata::tools {
@@ -19,5 +21,10 @@ void RegisterVehicles(CLI::App& app);
 void RegisterRegister(CLI::App& app);
 void RegisterFloors(CLI::App& app);
 void RegisterView(CLI::App& app);
+
+/// The processes this command runs on: this one alone, or the ranks of `mpirun` (docs/scale.md).
+/// Commands that share their work (integrate) pass it to the pipeline; the others run on
+/// rank 0 alone.
+[[nodiscard]] const pipeline::Ranks& CommandRanks();
 
 }  // namespace strata::tools

@@ -75,6 +75,7 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
         PrintAlignment(a, std::cerr);
     };
     options.on_start = [&args](const pipeline::IntegrationStart& s) { PrintStart(s, args); };
+    options.ranks = &CommandRanks();
     const pipeline::IntegrateResult r = pipeline::IntegrateSession(args.map, args.scans, options);
     std::cout << "session " << r.session.id << " (" << r.session.name << "): " << r.session.scans
               << " scans, " << r.session.points << " points in " << r.seconds << " s; wrote "

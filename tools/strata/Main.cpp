@@ -2,6 +2,9 @@
 #include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <optional>
+#include <streambuf>
+#include <string>
 
 #include "Commands.hpp"
 #include "strata/core/Error.hpp"
@@ -28,9 +31,43 @@ int ExitCodeOf(const std::exception& e) {
     return kFailed;
 }
 
-}  // namespace
+const strata::pipeline::Ranks* g_ranks = nullptr;
 
-int main(int argc, char** argv) {
+// Subcommands whose work is shared by the ranks of mpirun; the others run on rank 0 alone.
+bool SharesWork(int argc, char** argv) {
+    if (argc < 2) return false;
+    const std::string command = argv[1];
+    return command == "integrate";
+}
+
+// Swallows std::cout and std::cerr while it lives: the output of the ranks other than 0 (rank 0
+// reports for all of them, their errors included: pipeline::OnEveryRank).
+class Quiet {
+public:
+    Quiet() : out_(std::cout.rdbuf(&null_)), err_(std::cerr.rdbuf(&null_)) {}
+    ~Quiet() {
+        std::cout.rdbuf(out_);
+        std::cerr.rdbuf(err_);
+    }
+    Quiet(const Quiet&) = delete;
+    Quiet& operator=(const Quiet&) = delete;
+
+private:
+    struct Null : std::streambuf {
+        int overflow(int c) override { return c; }
+    } null_;
+    std::streambuf* out_;
+    std::streambuf* err_;
+};
+
+// Parses and runs one subcommand on `ranks`.
+int RunCommand(int argc, char** argv, const strata::pipeline::Ranks& ranks) {
+    g_ranks = &ranks;
+    std::optional<Quiet> quiet;
+    if (!ranks.root()) {
+        if (!SharesWork(argc, argv)) return EXIT_SUCCESS;  // rank 0 runs it alone
+        quiet.emplace();
+    }
     CLI::App app{"strata: a GPU-free voxel database for LiDAR maps"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "strata 0.1.0");
@@ -57,4 +94,19 @@ int main(int argc, char** argv) {
         return ExitCodeOf(e);
     }
     return EXIT_SUCCESS;
+}
+
+}  // namespace
+
+const strata::pipeline::Ranks& strata::tools::CommandRanks() { return *g_ranks; }
+
+int main(int argc, char** argv) {
+    try {
+        // MPI (under mpirun) is finalised when `ranks` goes, after the command.
+        const strata::pipeline::Ranks ranks = strata::pipeline::Ranks::FromEnvironment(&argc, &argv);
+        return RunCommand(argc, argv, ranks);
+    } catch (const std::exception& e) {
+        std::cerr << "strata: error: " << e.what() << "\n";
+        return ExitCodeOf(e);
+    }
 }

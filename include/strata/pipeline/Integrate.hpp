@@ -9,6 +9,7 @@
 #include "strata/pipeline/Alignment.hpp"
 #include "strata/pipeline/OpenOrCreate.hpp"
 #include "strata/pipeline/Progress.hpp"
+#include "strata/pipeline/Ranks.hpp"
 #include "strata/pipeline/ScanSource.hpp"
 #include "strata/store/SessionWriter.hpp"
 
@@ -35,6 +36,10 @@ struct IntegrateOptions {
     std::function<void(const MapAlignment&)> on_aligned;
     /// Called once before the first scan (the program prints the effective configuration).
     std::function<void(const IntegrationStart&)> on_start;
+    /// The processes that integrate the session together (docs/scale.md, "Integrate"); null or
+    /// one rank: this process alone. Every rank calls with the same arguments; callbacks run on
+    /// rank 0 only.
+    const Ranks* ranks = nullptr;
 
     /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;

@@ -1,0 +1,145 @@
+// `mpirun -n N strata integrate ...` end to end (docs/scale.md): the map one process makes, and
+// a rank killed mid-run leaves the map at its last commit.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "CliTestUtil.hpp"
+#include "MapDiff.hpp"
+#include "strata/store/MapStore.hpp"
+
+namespace strata::tools::test {
+namespace {
+
+const char* const kMpirun = "mpirun --allow-run-as-root --oversubscribe";
+
+Result Mpirun(int ranks, const std::string& args) {
+    const std::string cmd = std::string(kMpirun) + " -n " + std::to_string(ranks) + " " +
+                            STRATA_BINARY + " " + args + " 2>&1";
+    Result r;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf;
+    while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
+    const int status = pipe ? ::pclose(pipe) : -1;
+    if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
+    return r;
+}
+
+size_t Count(const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+// The map in `dir`, read whole, and every layer of its newest snapshot.
+void ExpectSameStores(const fs::path& a_dir, const fs::path& b_dir) {
+    const store::MapStore a = store::MapStore::Open(a_dir, store::MapStore::Access::kRead);
+    const store::MapStore b = store::MapStore::Open(b_dir, store::MapStore::Access::kRead);
+    EXPECT_EQ(testing::MapDifference(a.LoadMap(a.Latest()), b.LoadMap(b.Latest())), "");
+    const store::Snapshot sa = a.Latest(), sb = b.Latest();
+    ASSERT_EQ(sa.layers.size(), sb.layers.size());
+    for (size_t i = 0; i < sa.layers.size(); ++i) {
+        const store::SessionLayer la = a.ReadLayer(sa.layers[i]), lb = b.ReadLayer(sb.layers[i]);
+        EXPECT_EQ(testing::FirstDifference("occupied", *la.occupied, *lb.occupied), "");
+        EXPECT_EQ(testing::FirstDifference("free", *la.free, *lb.free), "");
+    }
+}
+
+TEST(MpiCli, IntegrateOnTwoAndThreeRanksGivesTheOneProcessMap) {
+    SequenceSpec spec;
+    spec.scans = 5;
+    spec.room_half_m = Eigen::Vector3d(6.0, 4.0, 1.5);
+    const fs::path seq = MakeSequence(Temp("mpi_seq"), spec);
+    const std::string flags = " --kitti " + seq.string() + " --voxel 0.1 --tile-size 3.2";
+    const fs::path one = Temp("mpi_one");
+    ASSERT_EQ(Strata("integrate " + one.string() + flags).code, 0);
+    for (int ranks : {2, 3}) {
+        const fs::path many = Temp("mpi_many_" + std::to_string(ranks));
+        const Result r = Mpirun(ranks, "integrate " + many.string() + flags);
+        ASSERT_EQ(r.code, 0) << r.out;
+        EXPECT_EQ(Count(r.out, "session 1 ("), 1u) << r.out;  // rank 0 reports, once
+        ExpectSameStores(many, one);
+        const Result check = Strata("check " + many.string());
+        EXPECT_EQ(check.code, 0) << check.out;
+    }
+    // Commands that do not share their work run on rank 0 alone: one answer.
+    const Result info = Mpirun(2, "info " + one.string());
+    EXPECT_EQ(info.code, 0) << info.out;
+    EXPECT_EQ(Count(info.out, "\nsessions:\n"), 1u) << info.out;
+}
+
+// The pid of the process of rank `rank` running `strata integrate` on `map`, or -1.
+pid_t RankPid(int rank, const fs::path& map) {
+    const std::string wanted = "OMPI_COMM_WORLD_RANK=" + std::to_string(rank);
+    for (const auto& e : fs::directory_iterator("/proc")) {
+        const std::string name = e.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+        std::ifstream cmd(e.path() / "cmdline", std::ios::binary), env(e.path() / "environ");
+        std::stringstream c, v;
+        c << cmd.rdbuf();
+        v << env.rdbuf();
+        const std::string cmdline = c.str(), environ = v.str();
+        if (cmdline.find(map.string()) == std::string::npos) continue;
+        if (cmdline.rfind(STRATA_BINARY, 0) != 0) continue;
+        if (environ.find(wanted + '\0') != std::string::npos) return std::stoi(name);
+    }
+    return -1;
+}
+
+TEST(MpiCli, AKilledRankFailsTheCommandAndLeavesTheLastCommit) {
+    const fs::path small = MakeSequence(Temp("mpi_kill_first"), SequenceSpec{});
+    SequenceSpec spec;
+    spec.scans = 60;
+    spec.points_per_scan = 40000;
+    spec.room_half_m = Eigen::Vector3d(15.0, 10.0, 3.0);
+    const fs::path large = MakeSequence(Temp("mpi_kill_seq"), spec);
+    const fs::path map = Temp("mpi_kill_map");
+    ASSERT_EQ(Strata("integrate " + map.string() + " --kitti " + small.string() +
+                     " --voxel 0.05 --tile-size 3.2")
+                  .code,
+              0);
+    const auto before = MapFiles(map);
+    const fs::path log_file = Temp("mpi_kill.log");  // Temp() empties the path: once
+    const std::string cmd = std::string(kMpirun) + " -n 2 " + STRATA_BINARY + " integrate " +
+                            map.string() + " --kitti " + large.string() + " > " +
+                            log_file.string() + " 2>&1";
+    int status = 0;
+    std::thread run([&] { status = std::system(cmd.c_str()); });
+    // Rank 1 is killed once it has started integrating.
+    pid_t victim = -1;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while ((victim = RankPid(1, map)) < 0 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_GT(victim, 0) << "rank 1 never started";
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    const bool killed = ::kill(victim, SIGKILL) == 0;
+    run.join();
+    const std::string log = ReadText(log_file);
+    std::printf("[ mpi ] rank 1 (pid %d) %s:\n%s\n", victim, killed ? "killed" : "had ended", log.c_str());
+    ASSERT_TRUE(killed) << "rank 1 finished before it could be killed; make the sequence longer";
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << "mpirun status " << status;
+    EXPECT_NE(log.find("rank 1"), std::string::npos) << log;  // mpirun names the rank
+    // The map is at its last commit: one session, its files as they were, and it checks clean.
+    const store::MapStore after = store::MapStore::Open(map, store::MapStore::Access::kRead);
+    EXPECT_EQ(after.Latest().sessions.size(), 1u);
+    const auto now = MapFiles(map);
+    for (const auto& [file, bytes] : before) {
+        ASSERT_TRUE(now.count(file)) << file;
+        EXPECT_EQ(now.at(file), bytes) << file;
+    }
+    const Result check = Strata("check " + map.string());
+    EXPECT_EQ(check.code, 0) << check.out;
+    // And the next command works.
+    EXPECT_EQ(Strata("integrate " + map.string() + " --kitti " + small.string()).code, 0);
+}
+
+}  // namespace
+}  // namespace strata::tools::test
