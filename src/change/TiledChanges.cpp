@@ -4,6 +4,7 @@
 #include "strata/change/TiledChanges.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <mutex>
 #include <set>
 
@@ -71,6 +72,43 @@ struct TileChanges {
 };
 
 }  // namespace
+
+TiledSide WholeSide(Observation observation, const store::MapSettings& settings) {
+    std::set<store::TileKey> keys;
+    for (const BoolGrid* mask : {observation.masks.occupied.get(), observation.masks.free.get()}) {
+        if (!mask) continue;
+        for (auto leaf = mask->tree().cbeginLeaf(); leaf; ++leaf) {
+            keys.insert(settings.TileOf(leaf->origin()));
+        }
+        for (auto on = mask->cbeginValueOn(); on; ++on) {  // active tiles above the leaves
+            if (on.isVoxelValue()) continue;
+            for (const store::TileKey& k : TilesMeeting(on.getBoundingBox(), settings)) {
+                keys.insert(k);
+            }
+        }
+    }
+    TiledSide side;
+    side.tiles.assign(keys.begin(), keys.end());
+    auto whole = std::make_shared<const Observation>(std::move(observation));
+    side.observe = [whole](const std::vector<store::TileKey>&, const CoordBBox& box) {
+        const auto cut = [&box](const BoolGrid::ConstPtr& grid) -> BoolGrid::Ptr {
+            if (!grid) return nullptr;
+            BoolGrid::Ptr part = grid->copyWithNewTree();
+            core::CopyInside(*grid, box, *part);
+            return part;
+        };
+        Observation part;
+        part.masks.occupied = cut(whole->masks.occupied);
+        part.masks.free = cut(whole->masks.free);
+        if (whole->labels) {
+            openvdb::Int32Grid::Ptr labels = whole->labels->copyWithNewTree();
+            core::CopyInside(*whole->labels, box, *labels);
+            part.labels = labels;
+        }
+        return part;
+    };
+    return side;
+}
 
 ChangeSet DetectChangesByTiles(const TiledSide& a, const TiledSide& b,
                                const store::MapSettings& settings, const ChangeQuery& query) {

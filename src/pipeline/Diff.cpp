@@ -2,26 +2,26 @@
 
 #include "strata/change/ChangeReport.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/GridBox.hpp"
 #include "strata/integration/Integrator.hpp"
 
 namespace strata::pipeline {
 
 DiffSide ResolveSide(const std::string& text, const store::MapStore& map,
                      change::MapObserver& observer) {
-    if (text == "map") return {observer.Map(map.Latest()), "map (newest)"};
+    if (text == "map") return {observer.MapSide(map.Latest()), "map (newest)"};
     if (text.rfind("map@", 0) == 0) {
         const int64_t id = map.FindSession(text.substr(4));
-        return {observer.Map(map.AsOf(id)), "map as of session " + std::to_string(id)};
+        return {observer.MapSide(map.AsOf(id)), "map as of session " + std::to_string(id)};
     }
     const int64_t id = map.FindSession(text);
-    return {observer.Session(id), "session " + std::to_string(id)};
+    return {observer.SessionSide(id), "session " + std::to_string(id)};
 }
 
 DiffResult CompareSides(const DiffSide& a, const DiffSide& b, const store::MapStore& map,
                         const change::ChangeQuery& query) {
     DiffResult result;
-    result.changes =
-        change::DetectChanges(a.observation, b.observation, map.settings().voxel_size_m, query);
+    result.changes = change::DetectChangesByTiles(a.side, b.side, map.settings(), query);
     const change::ReportContext context{a.name, b.name, map.settings().origin, &query};
     result.report = change::ChangeReportJson(result.changes, context);
     return result;
@@ -33,8 +33,28 @@ DiffSide ObserveScans(const store::MapStore& map, const ScanSpec& scans) {
     // The rule the map was built with, so the two sides weigh evidence alike.
     integration::Integrator integrator(scratch, map.settings().integration);
     for (size_t i = 0; i < source.size(); ++i) (void)integrator.Integrate(source.Read(i));
-    return {change::ObserveMap(scratch),
+    return {change::WholeSide(change::ObserveMap(scratch), map.settings()),
             "scans " + source.Describe() + " (" + std::to_string(source.size()) + ", uncommitted)"};
+}
+
+openvdb::BoolGrid::Ptr SeenOccupied(const DiffSide& a, const DiffSide& b,
+                                    const store::MapStore& map,
+                                    const std::optional<core::Region>& region) {
+    const store::MapSettings& settings = map.settings();
+    openvdb::BoolGrid::Ptr seen = a.side.observe({}, openvdb::CoordBBox()).masks.occupied;
+    if (!seen) throw InvalidArgumentError("change picture: a side without occupancy");
+    for (const DiffSide* side : {&a, &b}) {
+        for (const store::TileKey& key : side->side.tiles) {
+            const openvdb::CoordBBox box = settings.TileBounds(key);
+            const change::Observation part = side->side.observe({key}, box);
+            if (!part.masks.occupied) continue;
+            openvdb::BoolGrid::Ptr piece = part.masks.occupied->deepCopy();
+            core::KeepInside(*piece, box);
+            seen->topologyUnion(*piece);
+        }
+    }
+    if (region) region->Clip(*seen, settings.voxel_size_m);
+    return seen;
 }
 
 int64_t SaveChangeSet(store::MapStore& map, const DiffSide& a, const DiffSide& b,

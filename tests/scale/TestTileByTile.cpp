@@ -188,11 +188,18 @@ TEST(TileByTile, ChangesReadTileByTileAreTheWholeMapsChanges) {
                                      map.settings(), query),
         change::DetectChanges(in_region.Session(1), in_region.Session(2), 0.1, query));
     change::ChangeQuery maps;
+    const change::ChangeSet whole_maps =
+        change::DetectChanges(observer.Map(map.AsOf(1)), observer.Map(map.Latest()), 0.1, maps);
     ExpectSameChanges(change::DetectChangesByTiles(observer.MapSide(map.AsOf(1)),
                                                    observer.MapSide(map.Latest()), map.settings(),
                                                    maps),
-                      change::DetectChanges(observer.Map(map.AsOf(1)), observer.Map(map.Latest()),
-                                            0.1, maps));
+                      whole_maps);
+    // A side already in memory (scans `strata diff` integrated but did not commit), cut per tile.
+    ExpectSameChanges(
+        change::DetectChangesByTiles(observer.MapSide(map.AsOf(1)),
+                                     change::WholeSide(observer.Map(map.Latest()), map.settings()),
+                                     map.settings(), maps),
+        whole_maps);
 }
 
 }  // namespace

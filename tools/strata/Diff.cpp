@@ -127,9 +127,7 @@ void Run(const DiffArgs& args) {
     const change::ReportContext context{a.name, b.name, map.settings().origin, &query};
     if (!args.vdb.empty()) change::WriteChangeVdb(changes, context, args.vdb);
     if (!args.png.empty()) {
-        openvdb::BoolGrid::Ptr seen = a.observation.masks.occupied->deepCopy();
-        seen->topologyUnion(*b.observation.masks.occupied);
-        if (query.region) query.region->Clip(*seen, map.settings().voxel_size_m);
+        const openvdb::BoolGrid::Ptr seen = pipeline::SeenOccupied(a, b, map, query.region);
         change::WriteChangePng(changes, *seen, args.png);
     }
     if (args.json) {

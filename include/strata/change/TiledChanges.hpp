@@ -21,6 +21,10 @@ struct TiledSide {
         observe;
 };
 
+/// @brief An observation already in memory (scans not yet integrated) as a side: its tiles, and
+/// copies of it cut to the box asked for. `observation` is shared, not copied.
+[[nodiscard]] TiledSide WholeSide(Observation observation, const store::MapSettings& settings);
+
 /// @brief DetectChanges(a, b) read tile by tile: every tile of either side is observed with a
 /// halo from its neighbours (the safeguards' reach), its confident changes are kept, groups are
 /// formed across tile borders, growth runs tile by tile again, and objects are grouped across

@@ -3,23 +3,27 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "strata/change/ChangeDetection.hpp"
 #include "strata/change/MapObserver.hpp"
+#include "strata/change/TiledChanges.hpp"
 #include "strata/pipeline/ScanSource.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::pipeline {
 
-/// @brief One side of a change query and the name its report gives it.
+/// @brief One side of a change query, read tile by tile (docs/change.md, "Tile by tile"), and
+/// the name its report gives it.
 struct DiffSide {
-    change::Observation observation;
+    change::TiledSide side;
     std::string name;
 };
 
 /// @brief A side named as `strata diff` names them: "map" (the newest map), "map@SESSION" (the
-/// map right after SESSION) or SESSION (an id or name: what that session saw).
+/// map right after SESSION) or SESSION (an id or name: what that session saw). The side reads
+/// through `observer` (its region and memory budget) and must not outlive it.
 /// @throw NotFoundError (or the store's error) for an unknown session.
 [[nodiscard]] DiffSide ResolveSide(const std::string& text, const store::MapStore& map,
                                    change::MapObserver& observer);
@@ -31,7 +35,7 @@ struct DiffResult {
 };
 
 /// @brief Detects the changes between two sides of `map` with `query` (its region, class filter
-/// and thresholds) and writes the report.
+/// and thresholds) tile by tile, a few tiles in memory at a time, and writes the report.
 [[nodiscard]] DiffResult CompareSides(const DiffSide& a, const DiffSide& b,
                                       const store::MapStore& map, const change::ChangeQuery& query);
 
@@ -39,6 +43,12 @@ struct DiffResult {
 /// origin and integration rule (so both sides weigh evidence alike); the map is only read.
 /// @throw the errors of ScanSource::Open, its readers and the integration.
 [[nodiscard]] DiffSide ObserveScans(const store::MapStore& map, const ScanSpec& scans);
+
+/// @brief Where either side saw something occupied (inside `region`): the background of
+/// change pictures. Read tile by tile; holds the occupied voxels of both sides.
+[[nodiscard]] openvdb::BoolGrid::Ptr SeenOccupied(const DiffSide& a, const DiffSide& b,
+                                                  const store::MapStore& map,
+                                                  const std::optional<core::Region>& region);
 
 /// @brief Keeps a comparison in the map's catalog as one `change_sets` commit (a row of the
 /// `change_sets` view: from_side, to_side, the counts and the report); returns the row's id.
