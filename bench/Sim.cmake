@@ -12,3 +12,5 @@ strata_set_warnings(bench_district)
 if(TARGET strata)
   add_dependencies(bench_district strata)
 endif()
+# --scale runs `mpirun -n 1|2 strata integrate` (empty without Open MPI: --scale then refuses).
+target_compile_definitions(bench_district PRIVATE STRATA_MPIEXEC="$<$<BOOL:${MPIEXEC_EXECUTABLE}>:${MPIEXEC_EXECUTABLE}>")

@@ -1,8 +1,11 @@
 // The district the scale-out work is measured on (docs/simulator.md, "Districts"; docs/bench.md,
 // "District"): `strata simulate` of datasets/scenes/district.json, then `strata integrate` of each
 // session at 0.2 m, each timed and its peak RSS taken from the kernel (wait4), then the map's
-// tiles and size from `strata info --json`. Takes minutes; not run in CI.
-// Usage: bench_district [--scene FILE] [--work DIR] [--memory-budget MB] [--keep]
+// tiles and size from `strata info --json`. With --scale, then (docs/scale.md, "Measured"): the
+// first session integrated again by one and by two `mpirun` ranks of one thread each (the same
+// map, compared byte for byte through a PLY export), and the map-reading commands under
+// `--memory-budget 512`, each with its peak RSS. Takes minutes; not run in CI.
+// Usage: bench_district [--scene FILE] [--work DIR] [--memory-budget MB] [--scale] [--keep]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -44,7 +47,7 @@ Run Execute(const std::vector<std::string>& args, const fs::path& out) {
     rusage usage{};
     if (pid < 0 || wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) ||
         WEXITSTATUS(status) != 0) {
-        std::fprintf(stderr, "bench_district: %s failed\n", args[1].c_str());
+        std::fprintf(stderr, "bench_district: %s %s failed\n", args[0].c_str(), args[1].c_str());
         std::exit(1);
     }
     const double seconds =
@@ -71,13 +74,68 @@ double Megabytes(const fs::path& dir) {
     return static_cast<double>(bytes) / 1e6;
 }
 
+bool SameBytes(const fs::path& a, const fs::path& b) {
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    return fa && fb && std::equal(std::istreambuf_iterator<char>(fa), {},
+                                  std::istreambuf_iterator<char>(fb), {});
+}
+
+// The scale-out numbers of docs/scale.md: integrate on one and two ranks, then the map-reading
+// commands under a 512 MB budget. Exits non-zero when the two maps differ.
+void Scale(const std::string& strata, const fs::path& work, const std::string& session_dir) {
+    const std::string mpirun = STRATA_MPIEXEC;
+    if (mpirun.empty()) {
+        std::fprintf(stderr, "bench_district: --scale needs mpirun (openmpi-bin)\n");
+        std::exit(1);
+    }
+    std::printf("\n| integrate the first session | s | peak RSS MB (one rank) | speed-up |\n"
+                "|---|---|---|---|\n");
+    double one_rank_s = 0.0;
+    for (const int ranks : {1, 2}) {
+        const fs::path map = work / ("ranks" + std::to_string(ranks));
+        const Run r = Execute({mpirun, "--allow-run-as-root", "--oversubscribe", "-n",
+                               std::to_string(ranks), strata, "integrate", map.string(),
+                               "--kitti", session_dir, "--voxel", "0.2", "--threads", "1"},
+                              work / "integrate_ranks.txt");
+        if (ranks == 1) one_rank_s = r.seconds;
+        (void)Execute({strata, "export", map.string(), "--out", (map.string() + ".ply")},
+                      work / "export.txt");
+        std::printf("| mpirun -n %d, --threads 1 | %.0f | %.0f | %.2fx |\n", ranks, r.seconds,
+                    r.peak_rss_mb, one_rank_s / r.seconds);
+    }
+    const bool same = SameBytes(work / "ranks1.ply", work / "ranks2.ply");
+    std::printf("\nthe two maps' PLY exports are %s\n", same ? "byte-identical" : "DIFFERENT");
+    fs::remove(work / "ranks1.ply");
+    fs::remove(work / "ranks2.ply");
+    fs::remove_all(work / "ranks2");
+    // Map-reading commands on the first session's map under --memory-budget 512.
+    const std::string map = (work / "ranks1").string();
+    struct Command {
+        std::string name;
+        std::vector<std::string> args;
+    };
+    const std::vector<Command> commands = {
+        {"info", {strata, "info", map}},
+        {"export PLY", {strata, "export", map, "--out", (work / "map.ply").string(),
+                        "--memory-budget", "512"}},
+        {"export VDB --split", {strata, "export", map, "--out", (work / "split.vdb").string(),
+                                "--split", "--memory-budget", "512"}},
+    };
+    std::printf("\n| command (--memory-budget 512) | s | peak RSS MB |\n|---|---|---|\n");
+    for (const Command& c : commands) {
+        const Run r = Execute(c.args, work / "command.txt");
+        std::printf("| %s | %.1f | %.0f |\n", c.name.c_str(), r.seconds, r.peak_rss_mb);
+    }
+    if (!same) std::exit(1);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     fs::path scene = fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/district.json";
     fs::path work = fs::temp_directory_path() / "bench_district";
     std::string budget = "0";
-    bool keep = false;
+    bool keep = false, scale = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--scene" && i + 1 < argc)
@@ -88,9 +146,12 @@ int main(int argc, char** argv) {
             budget = argv[++i];
         else if (a == "--keep")
             keep = true;
+        else if (a == "--scale")
+            scale = true;
         else {
             std::fprintf(stderr,
-                         "usage: %s [--scene FILE] [--work DIR] [--memory-budget MB] [--keep]\n",
+                         "usage: %s [--scene FILE] [--work DIR] [--memory-budget MB] [--scale] "
+                         "[--keep]\n",
                          argv[0]);
             return 2;
         }
@@ -149,6 +210,7 @@ int main(int argc, char** argv) {
         info.at("tile_size_m").get<double>(), Megabytes(work / "map"),
         info.at("tile_bytes").get<double>() / 1e6, info.at("occupied_voxels").get<double>() / 1e6,
         info.at("free_voxels").get<double>() / 1e6, Shell("uptime").c_str());
+    if (scale) Scale(strata, work, report.at("sessions").at(0).at("dir").get<std::string>());
     if (!keep) fs::remove_all(work);
     return 0;
 }
