@@ -1,11 +1,12 @@
 #include "strata/columns/ColumnStats.hpp"
-#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::columns {
 namespace {
@@ -82,8 +83,19 @@ ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map) {
             box.expand(tile_box);
         }
     }
-    ColumnGrid g = Allocate(box);
+    return FromMap(map, box);
+}
+
+ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map, const openvdb::CoordBBox& columns) {
+    if (!map.occupancy) throw InvalidArgumentError("column statistics: the map has no occupancy");
+    const openvdb::CoordBBox raster(openvdb::Coord(columns.min().x(), columns.min().y(), 0),
+                                    openvdb::Coord(columns.max().x(), columns.max().y(), 0));
+    ColumnGrid g = Allocate(raster);
     if (g.empty()) return g;
+    const auto inside = [&](const openvdb::Coord& ijk) {
+        return ijk.x() >= raster.min().x() && ijk.x() <= raster.max().x() &&
+               ijk.y() >= raster.min().y() && ijk.y() <= raster.max().y();
+    };
     auto hits = map.endpoints ? std::optional(core::EndpointReader(map)) : std::nullopt;
     auto label = map.label ? std::optional(map.label->getConstAccessor()) : std::nullopt;
     for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
@@ -92,6 +104,7 @@ ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map) {
         it.getBoundingBox(voxels);  // one voxel, or every voxel of a tile
         for (auto v = voxels.begin(); v; ++v) {
             const openvdb::Coord& ijk = *v;
+            if (!inside(ijk)) continue;
             const int64_t points = hits ? hits->Hits(ijk) : 1;
             const int cls = label ? label->getValue(ijk) : -1;
             AddVoxel(g.Mutable(ijk.x(), ijk.y()), ijk.z(), points, cls);

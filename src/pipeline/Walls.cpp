@@ -2,14 +2,24 @@
 
 #include <nlohmann/json.hpp>
 
+#include "WallsByTiles.hpp"
 #include "strata/pipeline/MapAccess.hpp"
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::pipeline {
 
+bool WallsReadWhole(const store::MapStore& map, const store::Snapshot& snapshot,
+                    size_t memory_budget_bytes) {
+    return memory_budget_bytes == 0 || map.Bytes(snapshot).fused_current <= memory_budget_bytes;
+}
+
 WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
-                       const walls::WallConfig& config) {
+                       const walls::WallConfig& config, size_t memory_budget_bytes) {
     config.Validate();
+    // Whole when it fits: the same walls as tile by tile, without reading the halos again.
+    if (!WallsReadWhole(map, snapshot, memory_budget_bytes)) {
+        return detail::FindWallsByTiles(map, snapshot, config, memory_budget_bytes);
+    }
     WallsOutcome outcome;
     outcome.map = map.LoadMap(snapshot);
     outcome.commit = snapshot.commit;

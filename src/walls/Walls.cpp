@@ -1,7 +1,5 @@
 #include "strata/walls/Walls.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -9,7 +7,9 @@
 #include <numeric>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
+#include "strata/core/Error.hpp"
 #include "strata/geometry/Clustering.hpp"
 #include "strata/geometry/PlaneFit.hpp"
 
@@ -405,25 +405,37 @@ private:
 WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     config.Validate();
     if (!map.occupancy) throw InvalidArgumentError("walls: the map has no occupancy grid");
-    WallResult result;
+    WallResult voted;
     const double s = map.voxel_size;
-    result.voxel_size = s;
-    Pipeline pipeline(map, config, result);
+    voted.voxel_size = s;
 
     // 1. Column statistics, the ground and the votes.
-    auto t = Clock::now();
-    const int radius = std::max(0, static_cast<int>(std::lround(config.window_m / s / 2.0 - 0.5)));
+    const auto t = Clock::now();
+    const int radius = WindowRadius(s, config);
     const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(map);
-    result.stats.occupied_columns = cols.OccupiedColumns();
-    result.ground = EstimateGround(map, cols, config.seed);
-    if (config.level_to_ground) result.up = result.ground.normal;
+    voted.stats.occupied_columns = cols.OccupiedColumns();
+    voted.ground = EstimateGround(map, cols, config.seed);
     const std::vector<openvdb::Coord> candidates =
-        VoteCandidates(map, cols.Window(radius), radius, config, &result.stats.voting_columns);
+        VoteCandidates(map, cols.Window(radius), radius, config, &voted.stats.voting_columns);
+    voted.stats.seconds_columns = Seconds(t);
+    return FindWallsAmong(map, candidates, std::move(voted), config);
+}
+
+WallResult FindWallsAmong(const core::VoxelMap& map, const std::vector<openvdb::Coord>& candidates,
+                          WallResult voted, const WallConfig& config) {
+    config.Validate();
+    if (!map.occupancy) throw InvalidArgumentError("walls: the map has no occupancy grid");
+    WallResult result = std::move(voted);
+    result.voxel_size = map.voxel_size;
+    result.walls.clear();
+    result.parts.clear();
+    result.up = config.level_to_ground ? result.ground.normal : Eigen::Vector3d::UnitZ();
     result.stats.candidate_voxels = candidates.size();
-    result.stats.seconds_columns = Seconds(t);
+    result.stats.clusters = result.stats.noise_voxels = 0;
+    Pipeline pipeline(map, config, result);
 
     // 2. DBSCAN, then K-means inside each cluster.
-    t = Clock::now();
+    auto t = Clock::now();
     const auto parts = pipeline.Parts(candidates);
     result.stats.seconds_clustering = Seconds(t);
 

@@ -36,6 +36,11 @@ public:
 
     /// @brief Statistics of every occupied column of `map` (occupancy > 0).
     [[nodiscard]] static ColumnGrid FromMap(const core::VoxelMap& map);
+    /// @brief The same over the columns of `columns` (x/y; z ignored), the raster covering
+    /// exactly them: a part of a map (a tile and its halo) gets the raster positions the whole
+    /// map would give its columns. Voxels outside are not counted.
+    [[nodiscard]] static ColumnGrid FromMap(const core::VoxelMap& map,
+                                            const openvdb::CoordBBox& columns);
     /// @brief Statistics of the columns of a set of voxels (all counted as occupied, one point
     /// each unless `points` gives a count per voxel).
     [[nodiscard]] static ColumnGrid FromVoxels(const std::vector<openvdb::Coord>& voxels,

@@ -2,6 +2,7 @@
 // Walls and their slant angles of a stored map (docs/walls.md), and the walls stored in the map
 // as a product commit: `strata walls` and Python's Map.walls.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -12,15 +13,29 @@ namespace strata::pipeline {
 
 /// @brief The snapshot analysed and the walls found in it.
 struct WallsOutcome {
-    core::VoxelMap map;  ///< the snapshot's fused map
+    /// The snapshot's fused map when read whole; tile by tile, only the voxels the stages after
+    /// voting read (the candidates, the occupancy within reach of them).
+    core::VoxelMap map;
     walls::WallResult result;
-    int64_t commit = 0;  ///< the snapshot's commit
+    int64_t commit = 0;      ///< the snapshot's commit
+    size_t tile_groups = 0;  ///< groups of tiles read one after another; 0: read whole
+    size_t kept_bytes = 0;   ///< tile by tile: memory of what was kept across groups
 };
 
-/// @brief Loads the snapshot and finds its walls (walls::FindWalls). The map is only read.
-/// @throw InvalidArgumentError for an invalid config; the store's errors.
+/// @brief Finds the walls of the snapshot (walls::FindWalls). A snapshot whose fused files fit
+/// `memory_budget_bytes` (0: no limit) is loaded whole; a larger one is read a group of tiles
+/// at a time, each with a halo of walls::HaloVoxels, and gives the same walls (docs/walls.md,
+/// "Tile by tile"). The map is only read.
+/// @throw InvalidArgumentError for an invalid config; RefusedError naming --memory-budget when
+/// one tile and its halo exceed the budget; the store's errors.
 [[nodiscard]] WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
-                                     const walls::WallConfig& config);
+                                     const walls::WallConfig& config,
+                                     size_t memory_budget_bytes = size_t{512} << 20);
+
+/// @brief Whether FindWalls loads the snapshot whole under this budget (outputs drawing the
+/// whole map, such as the slant map, need it).
+[[nodiscard]] bool WallsReadWhole(const store::MapStore& map, const store::Snapshot& snapshot,
+                                  size_t memory_budget_bytes);
 
 /// @brief One row of the walls view (docs/store.md, "Products"; each key: docs/walls.md):
 /// wall_id, center_x/y/z, normal_x/y/z, slant_deg, uncertainty_deg, lean_azimuth_deg, area_m2,

@@ -149,6 +149,26 @@ struct WallResult {
     double voxel_size = 0.0;
 };
 
+/// @brief Radius in columns of the voting window: `window_m` rounded to an odd voxel count.
+[[nodiscard]] int WindowRadius(double voxel_size, const WallConfig& config);
+
+/// @brief Stage 1's rule: whether a column's window statistics vote for walls.
+[[nodiscard]] bool WindowVotes(const columns::ColumnStat& window, double voxel_size, int radius,
+                               const WallConfig& config);
+
+/// How far the observed-side test looks from a voxel: 2 voxels along the normal from its mean.
+inline constexpr int kObservedSideReachVoxels = 3;
+
+/// @brief How far (x/y voxels) a part of a map must reach beyond its own columns for the walls
+/// of the whole map to be found from its parts: the voting window's radius, and the 3 voxels the
+/// observed-side test looks from a voxel (2 voxels along the normal from its mean).
+[[nodiscard]] int HaloVoxels(double voxel_size, const WallConfig& config);
+
+/// @brief The ground plane from the mean of the lowest occupied voxel of every occupied column,
+/// in raster order (j, then i), as EstimateGround takes them from a ColumnGrid.
+[[nodiscard]] GroundPlane FitGround(std::vector<Eigen::Vector3d> lowest, double voxel_size,
+                                    uint64_t seed = 1);
+
 /// @brief Stage 1 (voting): the occupied voxels of the columns whose window votes for walls,
 /// minus the ground at the bottom of the window. `window` is columns.Window(radius).
 [[nodiscard]] std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
@@ -161,5 +181,15 @@ struct WallResult {
 /// wall. Uses one thread. Throws InvalidArgumentError for a bad config or a map without
 /// occupancy.
 [[nodiscard]] WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config = {});
+
+/// @brief The stages after voting (DBSCAN, K-means, the wall tests, merging, one fit per wall)
+/// on `candidates` in the order VoteCandidates gives them (the occupancy tree's). `voted` brings
+/// stage 1's ground and counts. `map` needs the endpoints and labels of the candidates and the
+/// occupancy within HaloVoxels of them, nothing else: FindWalls(map) is
+/// FindWallsAmong(map, VoteCandidates(...), ...), and a map read tile by tile gives the same
+/// walls from only those voxels (pipeline::FindWalls).
+[[nodiscard]] WallResult FindWallsAmong(const core::VoxelMap& map,
+                                        const std::vector<openvdb::Coord>& candidates,
+                                        WallResult voted, const WallConfig& config);
 
 }  // namespace strata::walls

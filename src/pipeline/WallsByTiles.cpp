@@ -1,0 +1,306 @@
+// Walls tile by tile: stage 1 (column statistics, voting, the ground's lowest voxels) runs per
+// group of tiles with a halo of walls::HaloVoxels; what the later stages read (the candidates'
+// endpoints and labels, the occupancy within reach of them) is kept in one sparse map, and the
+// later stages run once on the union of every group's candidates. Walls across tile borders are
+// therefore joined by DBSCAN itself, and the result does not depend on the order of the groups:
+// the candidates are taken in the occupancy tree's order, the lowest voxels in raster order.
+#include "WallsByTiles.hpp"
+
+#include <openvdb/tools/Morphology.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "strata/core/Error.hpp"
+#include "strata/store/TileReader.hpp"
+
+namespace strata::pipeline::detail {
+namespace {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+using store::TileKey;
+
+// A tile's voxels grown by `halo` voxels in x and y (z spans everything already).
+CoordBBox Grown(const CoordBBox& box, int halo) {
+    return {box.min().offsetBy(-halo, -halo, 0), box.max().offsetBy(halo, halo, 0)};
+}
+
+std::vector<TileKey> Around(const TileKey& k) {
+    std::vector<TileKey> keys;
+    for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+            if (dx != 0 || dy != 0) keys.push_back({k.x + dx, k.y + dy});
+        }
+    }
+    return keys;
+}
+
+std::string Megabytes(double bytes) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.2f MB", bytes / 1e6);
+    return text;
+}
+
+// Adds the active voxels of `from` inside any of `boxes` to `into`, which holds no leaf where
+// `from` has one there: a neighbour tile's part in a group's halo.
+template <typename GridT>
+void CopyInsideAny(const GridT& from, const std::vector<CoordBBox>& boxes, GridT& into) {
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    const auto inside = [&](const Coord& c) {
+        return std::any_of(boxes.begin(), boxes.end(),
+                           [&](const CoordBBox& b) { return b.isInside(c); });
+    };
+    for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {
+        const CoordBBox bounds = leaf->getNodeBoundingBox();
+        if (std::none_of(boxes.begin(), boxes.end(),
+                         [&](const CoordBBox& b) { return b.hasOverlap(bounds); })) {
+            continue;
+        }
+        auto* copy = new LeafT(*leaf);
+        for (auto on = copy->beginValueOn(); on; ++on) {
+            if (!inside(on.getCoord())) on.setValueOff();
+        }
+        into.tree().addLeaf(copy);
+    }
+    for (auto it = from.tree().cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue()) continue;
+        for (const CoordBBox& b : boxes) {
+            CoordBBox part = it.getBoundingBox();
+            part.intersect(b);
+            if (!part.empty()) into.tree().fill(part, *it, true);
+        }
+    }
+}
+
+template <typename FromT, typename IntoT>
+void CopyValue(const FromT& from, IntoT& into, const Coord& c) {
+    typename IntoT::ValueType value{};
+    if (from.probeValue(c, value)) {
+        into.setValueOn(c, value);
+    } else {
+        into.setValueOff(c, value);
+    }
+}
+
+// What the groups leave for the stages after voting, and stage 1's counts.
+struct Kept {
+    core::VoxelMap map;
+    openvdb::BoolGrid::Ptr candidates = openvdb::BoolGrid::create(false);
+    struct Lowest {
+        int32_t j, i;
+        Eigen::Vector3d mean;
+    };
+    std::vector<Lowest> lowest;
+    std::vector<std::pair<int32_t, int32_t>> voting_empty;  // voting columns with no voxel
+    CoordBBox occupied;                                     // columns with an occupied voxel
+    size_t occupied_columns = 0, voting_columns = 0;
+};
+
+class Groups {
+public:
+    Groups(const store::Snapshot& snapshot, int halo) : halo_(halo) {
+        for (const store::TileVersion& t : snapshot.tiles) bytes_[t.key] = t.bytes;
+    }
+
+    // Fused bytes a group reads at once: its tiles, and the largest neighbour cut to its halo.
+    [[nodiscard]] uint64_t Cost(const std::vector<TileKey>& group) const {
+        const std::set<TileKey> in(group.begin(), group.end());
+        uint64_t own = 0, neighbour = 0;
+        for (const TileKey& k : group) {
+            own += Bytes(k);
+            for (const TileKey& a : Around(k)) {
+                if (!in.count(a)) neighbour = std::max(neighbour, Bytes(a));
+            }
+        }
+        return own + neighbour;
+    }
+
+    // Consecutive tiles (by key) while the budget holds.
+    [[nodiscard]] std::vector<std::vector<TileKey>> Split(size_t budget,
+                                                          const std::string& dir) const {
+        std::vector<std::vector<TileKey>> groups;
+        std::vector<TileKey> current;
+        for (const auto& entry : bytes_) {
+            const TileKey& key = entry.first;
+            if (Cost({key}) > budget) {
+                throw RefusedError(
+                    dir + ": tile " + std::to_string(key.x) + "_" + std::to_string(key.y) +
+                    " with its halo of " + std::to_string(halo_) + " voxels reads " +
+                    Megabytes(static_cast<double>(Cost({key}))) +
+                    " of fused files, more than the memory budget of " +
+                    Megabytes(static_cast<double>(budget)) + "; raise --memory-budget");
+            }
+            current.push_back(key);
+            if (Cost(current) > budget) {
+                current.pop_back();
+                groups.push_back(std::move(current));
+                current = {key};
+            }
+        }
+        if (!current.empty()) groups.push_back(std::move(current));
+        return groups;
+    }
+
+    [[nodiscard]] uint64_t Bytes(const TileKey& k) const {
+        const auto it = bytes_.find(k);
+        return it == bytes_.end() ? 0 : it->second;
+    }
+
+private:
+    int halo_;
+    std::map<TileKey, uint64_t> bytes_;
+};
+
+// Stage 1 on one group of tiles read with its halo; its results go into `kept`.
+void CollectGroup(const store::TileReader& reader, const store::MapSettings& settings,
+                  const std::vector<TileKey>& group, const Groups& groups, int halo,
+                  const walls::WallConfig& config, Kept& kept) {
+    const std::set<TileKey> in(group.begin(), group.end());
+    core::VoxelMap g = reader.LoadFused(group);
+    std::set<TileKey> neighbours;
+    for (const TileKey& k : group) {
+        for (const TileKey& a : Around(k)) {
+            if (!in.count(a) && groups.Bytes(a) > 0) neighbours.insert(a);
+        }
+    }
+    // The halo: each neighbour read alone, its voxels near the group's tiles kept.
+    for (const TileKey& n : neighbours) {
+        const CoordBBox bounds = settings.TileBounds(n);
+        std::vector<CoordBBox> boxes;
+        for (const TileKey& a : Around(n)) {
+            if (!in.count(a)) continue;
+            CoordBBox b = Grown(settings.TileBounds(a), halo);
+            b.intersect(bounds);
+            if (!b.empty()) boxes.push_back(b);
+        }
+        const auto tile = reader.Fused(n);
+        if (boxes.empty() || !tile) continue;
+        CopyInsideAny(*tile->occupancy, boxes, *g.occupancy);
+        CopyInsideAny(*tile->label, boxes, *g.label);
+        CopyInsideAny(*tile->endpoints, boxes, *g.endpoints);
+    }
+
+    // Column statistics over the group's tiles and halo, at the raster positions of the map's.
+    CoordBBox box;
+    for (const TileKey& k : group) box.expand(settings.TileBounds(k));
+    const double s = g.voxel_size;
+    const int radius = walls::WindowRadius(s, config);
+    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(g, Grown(box, halo));
+    const columns::ColumnGrid window = cols.Window(radius);
+    for (const TileKey& k : group) {
+        const CoordBBox t = settings.TileBounds(k);
+        for (int32_t j = t.min().y(); j <= t.max().y(); ++j) {
+            for (int32_t i = t.min().x(); i <= t.max().x(); ++i) {
+                const columns::ColumnStat& c = cols.At(i, j);
+                if (c.voxels > 0) {
+                    ++kept.occupied_columns;
+                    kept.occupied.expand(Coord(i, j, 0));
+                    kept.lowest.push_back({j, i, g.PointMean(Coord(i, j, c.k_min))});
+                }
+                if (walls::WindowVotes(window.At(i, j), s, radius, config)) {
+                    if (c.voxels > 0) {
+                        ++kept.voting_columns;
+                    } else {
+                        kept.voting_empty.emplace_back(i, j);
+                    }
+                }
+            }
+        }
+    }
+
+    // The group's own candidates, their endpoints and labels, and the occupancy around them.
+    openvdb::BoolGrid::Ptr mine = openvdb::BoolGrid::create(false);
+    {
+        auto mine_acc = mine->getAccessor();
+        auto all = kept.candidates->getAccessor();
+        const auto ends = g.endpoints->getConstAccessor();
+        const auto labels = g.label->getConstAccessor();
+        auto kept_ends = kept.map.endpoints->getAccessor();
+        auto kept_labels = kept.map.label->getAccessor();
+        for (const Coord& c : walls::VoteCandidates(g, window, radius, config)) {
+            if (!in.count(settings.TileOf(c))) continue;
+            mine_acc.setValueOn(c, true);
+            all.setValueOn(c, true);
+            CopyValue(ends, kept_ends, c);
+            CopyValue(labels, kept_labels, c);
+        }
+    }
+    openvdb::tools::dilateActiveValues(mine->tree(), walls::kObservedSideReachVoxels,
+                                       openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                       openvdb::tools::EXPAND_TILES);
+    const auto occupancy = g.occupancy->getConstAccessor();
+    auto kept_occupancy = kept.map.occupancy->getAccessor();
+    for (auto it = mine->cbeginValueOn(); it; ++it) {
+        const CoordBBox voxels = it.getBoundingBox();
+        for (auto v = voxels.begin(); v; ++v) {
+            float value = 0.0f;
+            if (occupancy.probeValue(*v, value)) kept_occupancy.setValueOn(*v, value);
+        }
+    }
+}
+
+}  // namespace
+
+WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
+                              const walls::WallConfig& config, size_t memory_budget_bytes) {
+    config.Validate();
+    const auto start = std::chrono::steady_clock::now();
+    const store::MapSettings& settings = map.settings();
+    const int halo = walls::HaloVoxels(settings.voxel_size_m, config);
+    if (halo >= settings.tile_voxels) {
+        throw InvalidArgumentError("walls: the halo (" + std::to_string(halo) +
+                                   " voxels) must be smaller than a tile");
+    }
+    const Groups groups(snapshot, halo);
+    const std::vector<std::vector<TileKey>> split =
+        groups.Split(memory_budget_bytes, map.dir().string());
+    // Nothing cached: each group is read, voted on and dropped.
+    const store::TileReader reader(map, snapshot, 0);
+    Kept kept;
+    kept.map = map.EmptyMap();
+    for (const std::vector<TileKey>& group : split) {
+        CollectGroup(reader, settings, group, groups, halo, config, kept);
+    }
+
+    walls::WallResult voted;
+    voted.voxel_size = settings.voxel_size_m;
+    voted.stats.occupied_columns = kept.occupied_columns;
+    voted.stats.voting_columns = kept.voting_columns;
+    for (const auto& [i, j] : kept.voting_empty) {
+        voted.stats.voting_columns += kept.occupied.isInside(Coord(i, j, 0));
+    }
+    std::sort(kept.lowest.begin(), kept.lowest.end(),
+              [](const auto& a, const auto& b) { return a.j != b.j ? a.j < b.j : a.i < b.i; });
+    std::vector<Eigen::Vector3d> lowest;
+    lowest.reserve(kept.lowest.size());
+    for (const auto& l : kept.lowest) lowest.push_back(l.mean);
+    voted.ground = walls::FitGround(std::move(lowest), settings.voxel_size_m, config.seed);
+    // The occupancy tree's order, as VoteCandidates gives a whole map's candidates.
+    std::vector<Coord> candidates;
+    for (auto it = kept.candidates->cbeginValueOn(); it; ++it) {
+        const CoordBBox voxels = it.getBoundingBox();
+        for (auto v = voxels.begin(); v; ++v) candidates.push_back(*v);
+    }
+    voted.stats.seconds_columns =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    WallsOutcome outcome;
+    outcome.commit = snapshot.commit;
+    outcome.tile_groups = split.size();
+    for (const auto& grid : kept.map.Grids()) outcome.kept_bytes += grid->memUsage();
+    outcome.kept_bytes += kept.candidates->memUsage() +
+                          kept.lowest.capacity() * sizeof(Kept::Lowest) +
+                          kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
+    outcome.result = walls::FindWallsAmong(kept.map, candidates, std::move(voted), config);
+    outcome.map = std::move(kept.map);
+    return outcome;
+}
+
+}  // namespace strata::pipeline::detail

@@ -1,0 +1,20 @@
+#pragma once
+// Walls of a stored map read a group of tiles at a time (docs/walls.md, "Tile by tile").
+
+#include <cstddef>
+
+#include "strata/pipeline/Walls.hpp"
+
+namespace strata::pipeline::detail {
+
+/// @brief The walls of the whole snapshot, reading groups of tiles whose fused files (and the
+/// largest neighbour read for their halo) stay within `memory_budget_bytes` on disk. Equal to
+/// walls::FindWalls on the loaded snapshot; `map` of the outcome holds only what the stages
+/// after voting read (the candidates and the occupancy within reach of them).
+/// @throw RefusedError naming --memory-budget when one tile and its halo exceed the budget.
+[[nodiscard]] WallsOutcome FindWallsByTiles(const store::MapStore& map,
+                                            const store::Snapshot& snapshot,
+                                            const walls::WallConfig& config,
+                                            size_t memory_budget_bytes);
+
+}  // namespace strata::pipeline::detail
