@@ -20,11 +20,6 @@ using openvdb::BoolGrid;
 using openvdb::Coord;
 using openvdb::CoordBBox;
 
-// A tile's voxels grown by `halo` voxels in x and y (z spans everything already).
-CoordBBox Grown(const CoordBBox& box, int halo) {
-    return {box.min().offsetBy(-halo, -halo, 0), box.max().offsetBy(halo, halo, 0)};
-}
-
 // The tiles that meet `box` in x/y.
 std::vector<store::TileKey> TilesMeeting(const CoordBBox& box, const store::MapSettings& s) {
     const auto tile = [&](int32_t i) {
@@ -122,7 +117,7 @@ ChangeSet DetectChangesByTiles(const TiledSide& a, const TiledSide& b,
 
     // The observations of both sides over a tile and its halo, restricted to the region.
     const auto observe = [&](const store::TileKey& key, int halo) {
-        const CoordBBox box = Grown(settings.TileBounds(key), halo);
+        const CoordBBox box = core::GrownXY(settings.TileBounds(key), halo);
         const std::vector<store::TileKey> near = TilesMeeting(box, settings);
         Observation oa = a.observe(near, box), ob = b.observe(near, box);
         detail::Require(oa, "A");
@@ -181,7 +176,7 @@ ChangeSet DetectChangesByTiles(const TiledSide& a, const TiledSide& b,
                  {std::tuple{seeds_removed.get(), oa.masks.occupied.get(), &ob.masks, &p.removed},
                   std::tuple{seeds_added.get(), ob.masks.occupied.get(), &oa.masks, &p.added}}) {
                 BoolGrid::Ptr near = seeds->copyWithNewTree();
-                core::CopyInside(*seeds, Grown(own, query.grow_voxels), *near);
+                core::CopyInside(*seeds, core::GrownXY(own, query.grow_voxels), *near);
                 const BoolGrid::Ptr candidates = detail::SeenOccupiedAndFree(*occupied, *other);
                 AppendVoxels(*detail::GrowInto(*near, *candidates, query.grow_voxels), own, *out);
             }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/GridBox.hpp"
 #include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline::detail {
@@ -26,11 +27,6 @@ namespace {
 using openvdb::Coord;
 using openvdb::CoordBBox;
 using store::TileKey;
-
-// A tile's voxels grown by `halo` voxels in x and y (z spans everything already).
-CoordBBox Grown(const CoordBBox& box, int halo) {
-    return {box.min().offsetBy(-halo, -halo, 0), box.max().offsetBy(halo, halo, 0)};
-}
 
 std::vector<TileKey> Around(const TileKey& k) {
     std::vector<TileKey> keys;
@@ -176,7 +172,7 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
         std::vector<CoordBBox> boxes;
         for (const TileKey& a : Around(n)) {
             if (!in.count(a)) continue;
-            CoordBBox b = Grown(settings.TileBounds(a), halo);
+            CoordBBox b = core::GrownXY(settings.TileBounds(a), halo);
             b.intersect(bounds);
             if (!b.empty()) boxes.push_back(b);
         }
@@ -192,7 +188,7 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
     for (const TileKey& k : group) box.expand(settings.TileBounds(k));
     const double s = g.voxel_size;
     const int radius = walls::WindowRadius(s, config);
-    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(g, Grown(box, halo));
+    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(g, core::GrownXY(box, halo));
     const columns::ColumnGrid window = cols.Window(radius);
     for (const TileKey& k : group) {
         const CoordBBox t = settings.TileBounds(k);

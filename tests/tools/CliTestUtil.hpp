@@ -40,8 +40,9 @@ struct Result {
 /// Runs `strata ARGS` through the shell (which execs it, so the status is the program's own) and
 /// waits for it. Nothing here signals the program: death by a signal is a crash and fails the
 /// calling test whatever it expected of the exit code.
-inline Result Strata(const std::string& args) {
-    const std::string cmd = "exec " + std::string(STRATA_BINARY) + " " + args + " 2>&1";
+/// Runs `command` through the shell, its stdout and stderr together, and waits for it.
+inline Result Shell(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     Result r;
     FILE* pipe = ::popen(cmd.c_str(), "r");
     std::array<char, 4096> buf;
@@ -49,6 +50,11 @@ inline Result Strata(const std::string& args) {
     const int status = pipe ? ::pclose(pipe) : -1;
     if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
     if (status != -1 && WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+    return r;
+}
+
+inline Result Strata(const std::string& args) {
+    Result r = Shell("exec " + std::string(STRATA_BINARY) + " " + args);
     if (r.signal != 0) {
         ADD_FAILURE() << "strata " << args << " died by signal " << r.signal << ":\n" << r.out;
     }

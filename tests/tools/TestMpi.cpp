@@ -4,7 +4,6 @@
 #include <signal.h>
 #include <sys/wait.h>
 
-#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -21,15 +20,8 @@ namespace {
 const char* const kMpirun = "mpirun --allow-run-as-root --oversubscribe";
 
 Result Mpirun(int ranks, const std::string& args) {
-    const std::string cmd = std::string(kMpirun) + " -n " + std::to_string(ranks) + " " +
-                            STRATA_BINARY + " " + args + " 2>&1";
-    Result r;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf;
-    while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-    const int status = pipe ? ::pclose(pipe) : -1;
-    if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-    return r;
+    return Shell(std::string(kMpirun) + " -n " + std::to_string(ranks) + " " + STRATA_BINARY +
+                 " " + args);
 }
 
 size_t Count(const std::string& text, const std::string& what) {

@@ -9,6 +9,11 @@
 
 namespace strata::core {
 
+/// @brief `box` grown by `halo` voxels in x and y (tile boxes span every z already).
+inline openvdb::CoordBBox GrownXY(const openvdb::CoordBBox& box, int halo) {
+    return {box.min().offsetBy(-halo, -halo, 0), box.max().offsetBy(halo, halo, 0)};
+}
+
 /// @brief Adds the active voxels of `from` inside `box` (values and states) to `into`, which
 /// must hold no leaf where `from` has one inside the box (the disjoint pieces of tiles).
 template <typename GridT>
