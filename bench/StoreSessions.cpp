@@ -135,11 +135,12 @@ std::vector<std::string> BenchSessions(const std::vector<core::Scan>& scans,
         "| session wall s (median of 3) | %.2f | %.2f | %.2f | (reported) |\n"
         "| disk growth MB per session (2nd vs last quarter) | %.2f | %.2f | %.3f | <= %.1f |\n"
         "| open + load current map s | | %.2f | | (reported) |\n",
-        n, Mb(static_cast<uint64_t>(bytes2)), Mb(static_cast<uint64_t>(bytes_n)),
-        bytes_n / bytes2, kMaxBytesRatio, cpu2, cpu_n, cpu_n / cpu2, config.max_time_ratio, wall2, wall_n,
+        n, Mb(static_cast<uint64_t>(bytes2)), Mb(static_cast<uint64_t>(bytes_n)), bytes_n / bytes2,
+        kMaxBytesRatio, cpu2, cpu_n, cpu_n / cpu2, config.max_time_ratio, wall2, wall_n,
         wall_n / wall2, early / 1e6, late / 1e6, late / early, kMaxGrowthRatio, open_n);
     if (bytes_n > kMaxBytesRatio * bytes2) missed.push_back("bytes per commit grow with the map");
-    if (cpu_n > config.max_time_ratio * cpu2) missed.push_back("time per session grows with the map");
+    if (cpu_n > config.max_time_ratio * cpu2)
+        missed.push_back("time per session grows with the map");
     if (late > kMaxGrowthRatio * early) missed.push_back("disk use grows faster than linearly");
 
     // Reading the current map whole reads its fused files and nothing else.
@@ -165,7 +166,8 @@ std::vector<std::string> BenchSessions(const std::vector<core::Scan>& scans,
     if (after.layers != before.layers) missed.push_back("reading the current map read layers");
     if (after.fused - before.fused != fused) missed.push_back("the fused read is not the map's");
     // rchar also counts the catalog pages; a layer file read would exceed this bound.
-    if (rchar_delta > fused + (uint64_t{4} << 20)) missed.push_back("rchar exceeds the fused bytes");
+    if (rchar_delta > fused + (uint64_t{4} << 20))
+        missed.push_back("rchar exceeds the fused bytes");
     fs::remove_all(dir);
     return missed;
 }
@@ -195,8 +197,7 @@ std::vector<std::string> BenchMigration(const std::vector<core::Scan>& scans, si
     const double seconds = Seconds(start);
     bool same = map.settings().format_version == 5;
     for (size_t s = 0; s < sessions && same; ++s) {
-        same = testing::MapDifference(map.LoadMap(map.AsOf(static_cast<int64_t>(s + 1))),
-                                      after[s])
+        same = testing::MapDifference(map.LoadMap(map.AsOf(static_cast<int64_t>(s + 1))), after[s])
                    .empty();
     }
     for (const auto& [session, expected] : layers) {

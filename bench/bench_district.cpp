@@ -76,8 +76,9 @@ double Megabytes(const fs::path& dir) {
 
 bool SameBytes(const fs::path& a, const fs::path& b) {
     std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
-    return fa && fb && std::equal(std::istreambuf_iterator<char>(fa), {},
-                                  std::istreambuf_iterator<char>(fb), {});
+    return fa && fb &&
+           std::equal(std::istreambuf_iterator<char>(fa), {}, std::istreambuf_iterator<char>(fb),
+                      {});
 }
 
 // The scale-out numbers of docs/scale.md: integrate on one and two ranks, then the map-reading
@@ -88,15 +89,16 @@ void Scale(const std::string& strata, const fs::path& work, const std::string& s
         std::fprintf(stderr, "bench_district: --scale needs mpirun (openmpi-bin)\n");
         std::exit(1);
     }
-    std::printf("\n| integrate the first session | s | peak RSS MB (one rank) | speed-up |\n"
-                "|---|---|---|---|\n");
+    std::printf(
+        "\n| integrate the first session | s | peak RSS MB (one rank) | speed-up |\n"
+        "|---|---|---|---|\n");
     double one_rank_s = 0.0;
     for (const int ranks : {1, 2}) {
         const fs::path map = work / ("ranks" + std::to_string(ranks));
-        const Run r = Execute({mpirun, "--allow-run-as-root", "--oversubscribe", "-n",
-                               std::to_string(ranks), strata, "integrate", map.string(),
-                               "--kitti", session_dir, "--voxel", "0.2", "--threads", "1"},
-                              work / "integrate_ranks.txt");
+        const Run r = Execute(
+            {mpirun, "--allow-run-as-root", "--oversubscribe", "-n", std::to_string(ranks), strata,
+             "integrate", map.string(), "--kitti", session_dir, "--voxel", "0.2", "--threads", "1"},
+            work / "integrate_ranks.txt");
         if (ranks == 1) one_rank_s = r.seconds;
         (void)Execute({strata, "export", map.string(), "--out", (map.string() + ".ply")},
                       work / "export.txt");
@@ -116,10 +118,11 @@ void Scale(const std::string& strata, const fs::path& work, const std::string& s
     };
     const std::vector<Command> commands = {
         {"info", {strata, "info", map}},
-        {"export PLY", {strata, "export", map, "--out", (work / "map.ply").string(),
-                        "--memory-budget", "512"}},
-        {"export VDB --split", {strata, "export", map, "--out", (work / "split.vdb").string(),
-                                "--split", "--memory-budget", "512"}},
+        {"export PLY",
+         {strata, "export", map, "--out", (work / "map.ply").string(), "--memory-budget", "512"}},
+        {"export VDB --split",
+         {strata, "export", map, "--out", (work / "split.vdb").string(), "--split",
+          "--memory-budget", "512"}},
     };
     std::printf("\n| command (--memory-budget 512) | s | peak RSS MB |\n|---|---|---|\n");
     for (const Command& c : commands) {

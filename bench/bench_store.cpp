@@ -40,9 +40,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using strata::bench::Clock;
 using strata::bench::CpuSeconds;
 using strata::bench::Mb;
-using strata::bench::Clock;
 using strata::bench::Seconds;
 using strata::core::Scan;
 using strata::core::VoxelMap;
@@ -364,8 +364,9 @@ int main(int argc, char** argv) try {
     std::vector<std::string> missed;
     const double five_sessions = Median(cpu_ratio[1]) - 1.0;
     const double max_overhead = quick ? kShortMaxFiveSessionOverhead : kMaxFiveSessionOverhead;
-    std::printf("\nBALM as 5 sessions (64 m tiles): CPU overhead %+.1f %% (held at most +%.0f %%)\n",
-                100.0 * five_sessions, 100.0 * max_overhead);
+    std::printf(
+        "\nBALM as 5 sessions (64 m tiles): CPU overhead %+.1f %% (held at most +%.0f %%)\n",
+        100.0 * five_sessions, 100.0 * max_overhead);
     if (five_sessions > max_overhead) missed.push_back("BALM 5-session overhead");
     for (size_t l = 0; l < layouts.size(); ++l) {
         if (!StoreMatchesMemory(dirs[l], memory)) missed.push_back("store != in-memory map");
@@ -447,8 +448,8 @@ int main(int argc, char** argv) try {
         for (std::string& m : strata::bench::BenchSessions(frames, config, tmp.path)) {
             missed.push_back(std::move(m));
         }
-        for (std::string& m : strata::bench::BenchMigration(frames, quick ? 4 : 10, kVoxel,
-                                                           tmp.path)) {
+        for (std::string& m :
+             strata::bench::BenchMigration(frames, quick ? 4 : 10, kVoxel, tmp.path)) {
             missed.push_back(std::move(m));
         }
         std::printf("\nKITTI 00: frames 0-%zu each session, voxel %.1f m, 64 m tiles.\n",

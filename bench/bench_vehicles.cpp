@@ -162,8 +162,8 @@ int main(int argc, char** argv) {
                 rest.push_back(argv[i]);
             }
         }
-        const auto args = strata::bench::ParseRepeatArgs(static_cast<int>(rest.size()),
-                                                         rest.data(), STRATA_DATA_DIR);
+        const auto args = strata::bench::ParseRepeatArgs(static_cast<int>(rest.size()), rest.data(),
+                                                         STRATA_DATA_DIR);
         const bool met = Accuracy();
         if (!accuracy_only) Speed(args.data, args.repeat);
         return met ? 0 : 1;

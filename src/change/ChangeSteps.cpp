@@ -130,10 +130,9 @@ size_t ObservedOnlyBy(const core::OccupancyMasks& a, const core::OccupancyMasks&
 void Require(const Observation& o, const char* side) {
     if (!o.masks.occupied || !o.masks.free) {
         throw InvalidArgumentError(std::string("change detection: side ") + side +
-                                    " has no occupied/free masks");
+                                   " has no occupied/free masks");
     }
 }
-
 
 void CollectObjects(const BoolGrid& added, const BoolGrid& removed,
                     const openvdb::Int32Grid* labels_a, const openvdb::Int32Grid* labels_b,
@@ -146,7 +145,8 @@ void CollectObjects(const BoolGrid& added, const BoolGrid& removed,
     for (const auto& [mask, kind, labels] :
          {std::tuple{&added, ChangeKind::kAdded, labels_b},
           std::tuple{&removed, ChangeKind::kRemoved, labels_a}}) {
-        for (ObjectVoxels& group : GroupObjects(*mask, kind, voxel_size, query.gap_voxels, labels)) {
+        for (ObjectVoxels& group :
+             GroupObjects(*mask, kind, voxel_size, query.gap_voxels, labels)) {
             if (group.object.voxels < query.min_voxels) continue;
             if (query.class_filter && group.object.dominant_class != *query.class_filter) continue;
             kept.push_back(std::move(group));

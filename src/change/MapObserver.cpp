@@ -115,7 +115,7 @@ TiledSide MapObserver::SessionSide(int64_t session_id) {
         if (std::binary_search(in_region.begin(), in_region.end(), key)) side.tiles.push_back(key);
     }
     side.observe = [this, reader, session_id](const std::vector<store::TileKey>& keys,
-                                             const openvdb::CoordBBox& box) {
+                                              const openvdb::CoordBBox& box) {
         return SessionOver(store_, reader, session_id, keys, box);
     };
     return side;

@@ -163,7 +163,8 @@ ChangeSet DetectChangesByTiles(const TiledSide& a, const TiledSide& b,
     // 2. Across tiles: the groups large enough to grow, then growth tile by tile (a tile needs
     // the seeds within the growth distance of it).
     if (query.grow_voxels > 0) {
-        const BoolGrid::Ptr seeds_added = detail::Cores(*GridOf(added, *empty.masks.occupied), query, s);
+        const BoolGrid::Ptr seeds_added =
+            detail::Cores(*GridOf(added, *empty.masks.occupied), query, s);
         const BoolGrid::Ptr seeds_removed =
             detail::Cores(*GridOf(removed, *empty.masks.occupied), query, s);
         core::ParallelFor(tiles.size(), [&](size_t i) {

@@ -1,9 +1,9 @@
 #include "strata/core/Labels.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::core {
 namespace {

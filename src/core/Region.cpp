@@ -1,10 +1,10 @@
 #include "strata/core/Region.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::core {
 
@@ -53,7 +53,7 @@ Region Region::Parse(const std::string& text) {
     }
     const auto bad = [&](const std::string& why) {
         return InvalidArgumentError("region '" + text + "': " + why +
-                                     " (expected x0,y0,x1,y1 or a polygon x0,y0,x1,y1,x2,y2,...)");
+                                    " (expected x0,y0,x1,y1 or a polygon x0,y0,x1,y1,x2,y2,...)");
     };
     try {
         if (values.size() == 4) return Box(values[0], values[1], values[2], values[3]);

@@ -1,8 +1,8 @@
 #include "strata/core/Scan.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::core {
 
@@ -11,15 +11,15 @@ void Scan::Validate() const {
     const size_t n = points.size();
     if (!labels.empty() && labels.size() != n) {
         throw InvalidArgumentError(where + ": " + std::to_string(labels.size()) + " labels for " +
-                                    std::to_string(n) + " points");
+                                   std::to_string(n) + " points");
     }
     if (!instances.empty() && instances.size() != n) {
         throw InvalidArgumentError(where + ": " + std::to_string(instances.size()) +
-                                    " instance ids for " + std::to_string(n) + " points");
+                                   " instance ids for " + std::to_string(n) + " points");
     }
     if (!intensity.empty() && intensity.size() != n) {
         throw InvalidArgumentError(where + ": " + std::to_string(intensity.size()) +
-                                    " intensities for " + std::to_string(n) + " points");
+                                   " intensities for " + std::to_string(n) + " points");
     }
     if (!T_world_sensor.matrix().allFinite()) {
         throw InvalidArgumentError(where + ": the sensor pose is not finite");

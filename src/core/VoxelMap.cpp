@@ -31,7 +31,7 @@ typename GridT::Ptr FindGrid(const openvdb::GridPtrVec& grids, const char* name)
             auto typed = openvdb::gridPtrCast<GridT>(g);
             if (!typed) {
                 throw FormatError(std::string("grid '") + name + "' has type " + g->type() +
-                                         ", expected " + GridT::gridType());
+                                  ", expected " + GridT::gridType());
             }
             return typed;
         }
@@ -46,8 +46,8 @@ bool HasGrid(const openvdb::GridPtrVec& grids, const char* name) {
 
 void Stamp(openvdb::GridBase& grid, const Eigen::Vector3d& origin) {
     grid.insertMeta("producer", openvdb::StringMetadata(kProducer));
-    grid.insertMeta("origin", openvdb::Vec3DMetadata(openvdb::Vec3d(origin.x(), origin.y(),
-                                                                    origin.z())));
+    grid.insertMeta("origin",
+                    openvdb::Vec3DMetadata(openvdb::Vec3d(origin.x(), origin.y(), origin.z())));
 }
 
 openvdb::Int32Grid::Ptr MakeEndpointGrid(const openvdb::math::Transform::Ptr& xform) {
@@ -100,7 +100,7 @@ openvdb::math::Transform::Ptr VoxelMap::MakeTransform(double voxel_size_m) {
 VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
     if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m)) {
         throw InvalidArgumentError("voxel size must be positive, got " +
-                                    std::to_string(voxel_size_m));
+                                   std::to_string(voxel_size_m));
     }
     if (!origin.allFinite()) throw InvalidArgumentError("map origin must be finite");
     openvdb::initialize();
@@ -110,8 +110,8 @@ VoxelMap VoxelMap::Create(double voxel_size_m, const Eigen::Vector3d& origin) {
     const auto xform = MakeTransform(voxel_size_m);
     map.occupancy = MakeGrid<openvdb::FloatGrid>(grid_names::kOccupancy, xform, "log-odds",
                                                  openvdb::GRID_UNKNOWN);
-    map.label = MakeGrid<openvdb::Int32Grid>(grid_names::kLabel, xform, "class id",
-                                             openvdb::GRID_UNKNOWN);
+    map.label =
+        MakeGrid<openvdb::Int32Grid>(grid_names::kLabel, xform, "class id", openvdb::GRID_UNKNOWN);
     map.label_weight = MakeGrid<openvdb::FloatGrid>(grid_names::kLabelWeight, xform, "votes",
                                                     openvdb::GRID_UNKNOWN);
     map.endpoints = MakeEndpointGrid(xform);
@@ -139,13 +139,12 @@ openvdb::GridPtrVec VoxelMap::ExportGrids() const {
     grids.pop_back();  // endpoints, expanded instead
     auto hits = MakeGrid<openvdb::Int32Grid>(grid_names::kHits, occupancy->transform().copy(),
                                              "points", openvdb::GRID_UNKNOWN);
-    auto means = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean,
-                                              occupancy->transform().copy(),
+    auto means = MakeGrid<openvdb::Vec3SGrid>(grid_names::kPointMean, occupancy->transform().copy(),
                                               "m from the voxel centre", openvdb::GRID_UNKNOWN);
     hits->tree().topologyUnion(endpoints->tree());
     means->tree().topologyUnion(endpoints->tree());
     openvdb::tree::LeafManager<openvdb::Int32Tree> leaves(hits->tree());
-    leaves.foreach([&](openvdb::Int32Tree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](openvdb::Int32Tree::LeafNodeType& leaf, size_t) {
         const auto* packed = endpoints->tree().probeConstLeaf(leaf.origin());
         auto* mean = means->tree().probeLeaf(leaf.origin());
         for (auto on = leaf.beginValueOn(); on; ++on) {
@@ -178,7 +177,8 @@ VoxelMap VoxelMap::FromGrids(const openvdb::GridPtrVec& grids) {
             throw FormatError("grid '" + g.getName() + "' is not aligned with 'occupancy'");
         }
     };
-    for (const auto& g : {openvdb::GridBase::Ptr(map.label), openvdb::GridBase::Ptr(map.label_weight)}) {
+    for (const auto& g :
+         {openvdb::GridBase::Ptr(map.label), openvdb::GridBase::Ptr(map.label_weight)}) {
         require_aligned(*g);
     }
     if (HasGrid(grids, grid_names::kEndpoints)) {

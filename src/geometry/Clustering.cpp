@@ -1,15 +1,15 @@
 #include "strata/geometry/Clustering.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
-#include <utility>
 #include <stdexcept>
+#include <utility>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::geometry {
 

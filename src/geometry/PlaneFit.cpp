@@ -1,7 +1,5 @@
 #include "strata/geometry/PlaneFit.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
@@ -10,6 +8,8 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::geometry {
 namespace {

@@ -1,11 +1,11 @@
 #include "BinaryCursor.hpp"
 
-#include "TextParsing.hpp"
-#include "strata/core/Error.hpp"
-
 #include <algorithm>
 #include <cerrno>
 #include <fstream>
+
+#include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::io::detail {
 
@@ -24,9 +24,8 @@ std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path, size_t max
     std::vector<uint8_t> bytes(wanted);
     if (wanted > 0 &&
         !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(wanted))) {
-        throw IoError(path.string() + ": read error after " +
-                                 std::to_string(in.gcount()) + " of " + std::to_string(wanted) +
-                                 " bytes");
+        throw IoError(path.string() + ": read error after " + std::to_string(in.gcount()) + " of " +
+                      std::to_string(wanted) + " bytes");
     }
     return bytes;
 }

@@ -15,7 +15,8 @@
 namespace strata::io::detail {
 
 /// @brief Reads a file (at most its first `max_bytes`) into memory; throws the errors of
-/// RequireFile/FailOpen (TextParsing.hpp) or IoError naming it. `file_size`, when given, receives the size of the whole file.
+/// RequireFile/FailOpen (TextParsing.hpp) or IoError naming it. `file_size`, when given, receives
+/// the size of the whole file.
 [[nodiscard]] std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path,
                                                  size_t max_bytes = SIZE_MAX,
                                                  size_t* file_size = nullptr);

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "strata/core/Labels.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/Labels.hpp"
 #include "strata/core/VoxelMap.hpp"
 
 // What every exporter reads from a map: the checked grids, the class of a label value, and the
@@ -20,7 +20,7 @@ inline void RequireGrids(const core::VoxelMap& map, const std::string& target) {
     if (!map.occupancy || !map.label || !map.label_weight || !map.endpoints ||
         !(map.voxel_size > 0.0)) {
         throw InvalidArgumentError("cannot export " + target +
-                                    ": the map is not initialised (use VoxelMap::Create)");
+                                   ": the map is not initialised (use VoxelMap::Create)");
     }
 }
 inline void RequireGrids(const core::VoxelMap& map, const std::filesystem::path& path) {

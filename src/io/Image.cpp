@@ -1,5 +1,4 @@
 #include "strata/io/Image.hpp"
-#include "strata/core/Error.hpp"
 
 #include <png.h>
 
@@ -9,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "strata/core/Error.hpp"
 #include "strata/io/AtomicFile.hpp"
 
 namespace strata::io {
@@ -103,7 +103,7 @@ std::string LengthLabel(int mantissa, int exponent) {
 RgbImage::RgbImage(int width, int height, core::Rgb fill) : width_(width), height_(height) {
     if (width <= 0 || height <= 0) {
         throw InvalidArgumentError("image size must be positive, got " + std::to_string(width) +
-                                    " x " + std::to_string(height));
+                                   " x " + std::to_string(height));
     }
     pixels_.resize(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
     for (size_t i = 0; i < pixels_.size(); i += 3) {

@@ -70,8 +70,7 @@ void WriteKittiBin(const std::filesystem::path& path, const std::vector<Eigen::V
                    const std::vector<float>& intensity) {
     if (!intensity.empty() && intensity.size() != points.size()) {
         throw InvalidArgumentError(path.string() + ": " + std::to_string(intensity.size()) +
-                                    " intensities for " + std::to_string(points.size()) +
-                                    " points");
+                                   " intensities for " + std::to_string(points.size()) + " points");
     }
     std::string bytes;
     bytes.reserve(points.size() * kPointBytes);

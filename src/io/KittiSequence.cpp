@@ -1,5 +1,4 @@
 #include "strata/io/KittiSequence.hpp"
-#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -8,6 +7,7 @@
 
 #include "ScanBuilder.hpp"
 #include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PoseFiles.hpp"
 
 namespace strata::io {
@@ -61,8 +61,7 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
     }
     const fs::path velodyne = dir / "velodyne";
     if (!fs::is_directory(velodyne, ec)) {
-        throw NotFoundError(velodyne.string() +
-                                 ": missing (KITTI layout: velodyne/NNNNNN.bin)");
+        throw NotFoundError(velodyne.string() + ": missing (KITTI layout: velodyne/NNNNNN.bin)");
     }
     const std::vector<ScanFile> scans = ListScans(velodyne);
     if (scans.empty()) throw NotFoundError(velodyne.string() + ": holds no .bin scans");
@@ -72,9 +71,9 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
     const std::vector<Eigen::Isometry3d> poses = ReadKittiPoses(poses_txt);
     if (poses.size() < frames_needed) {
         throw FormatError(poses_txt.string() + ": " + std::to_string(poses.size()) +
-                                 " poses, but the sequence has " + std::to_string(scans.size()) +
-                                 " scans up to frame " + std::to_string(frames_needed - 1) +
-                                 ", which needs " + std::to_string(frames_needed));
+                          " poses, but the sequence has " + std::to_string(scans.size()) +
+                          " scans up to frame " + std::to_string(frames_needed - 1) +
+                          ", which needs " + std::to_string(frames_needed));
     }
     const fs::path calib_txt = dir / "calib.txt";
     const Eigen::Isometry3d Tr =
@@ -86,9 +85,8 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
         times = ReadTimes(times_txt);
         if (times.size() < frames_needed) {
             throw FormatError(times_txt.string() + ": " + std::to_string(times.size()) +
-                                     " timestamps, but frames up to " +
-                                     std::to_string(frames_needed - 1) + " need " +
-                                     std::to_string(frames_needed));
+                              " timestamps, but frames up to " + std::to_string(frames_needed - 1) +
+                              " need " + std::to_string(frames_needed));
         }
     }
     const fs::path labels_dir = dir / "labels";
@@ -106,9 +104,9 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
         label += ".label";
         if (!fs::is_regular_file(label, ec)) {
             throw NotFoundError(label.string() +
-                                     ": missing; labels/ must hold one .label "
-                                     "per scan (" +
-                                     std::to_string(scans.size()) + " scans)");
+                                ": missing; labels/ must hold one .label "
+                                "per scan (" +
+                                std::to_string(scans.size()) + " scans)");
         }
         seq.label_files.push_back(label);
     }
@@ -118,7 +116,7 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
 core::Scan ReadKittiScan(const KittiSequence& seq, size_t index) {
     if (index >= seq.size()) {
         throw InvalidArgumentError("ReadKittiScan: index " + std::to_string(index) +
-                                    " out of range for " + std::to_string(seq.size()) + " scans");
+                                   " out of range for " + std::to_string(seq.size()) + " scans");
     }
     const fs::path& bin = seq.scan_files[index];
     KittiPoints raw = ReadKittiBin(bin);
@@ -133,8 +131,8 @@ core::Scan ReadKittiScan(const KittiSequence& seq, size_t index) {
         const std::vector<uint32_t> labels = ReadKittiLabels(label_file);
         if (labels.size() != scan.points.size()) {
             throw FormatError(label_file.string() + ": " + std::to_string(labels.size()) +
-                                     " labels for " + std::to_string(scan.points.size()) +
-                                     " points in " + bin.string());
+                              " labels for " + std::to_string(scan.points.size()) + " points in " +
+                              bin.string());
         }
         const core::LabelMapping& mapping = detail::KittiMapping();
         scan.labels.reserve(labels.size());

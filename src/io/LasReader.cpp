@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "BinaryCursor.hpp"
-#include "strata/core/Error.hpp"
 #include "ScanBuilder.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
@@ -84,8 +84,8 @@ LasHeader ParseLasHeader(detail::BinaryCursor& c, size_t file_size) {
 
 [[noreturn]] void RefuseLaz(const std::string& file) {
     throw FormatError(file +
-                             ": LAZ (compressed LAS) is not supported; decompress it first, e.g. "
-                             "`pdal translate in.laz out.las` or `laszip -i in.laz -o out.las`");
+                      ": LAZ (compressed LAS) is not supported; decompress it first, e.g. "
+                      "`pdal translate in.laz out.las` or `laszip -i in.laz -o out.las`");
 }
 
 }  // namespace

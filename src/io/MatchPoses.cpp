@@ -4,8 +4,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "strata/io/PoseFiles.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/io/PoseFiles.hpp"
 
 namespace strata::io {
 namespace {
@@ -21,7 +21,7 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
                                           double max_dt_s) {
     if (!(max_dt_s >= 0.0)) {
         throw InvalidArgumentError("MatchPoses: max_dt_s must be >= 0, got " +
-                                    std::to_string(max_dt_s));
+                                   std::to_string(max_dt_s));
     }
     const size_t stamped = static_cast<size_t>(std::count_if(
         poses.begin(), poses.end(), [](const StampedPose& p) { return !std::isnan(p.time_s); }));
@@ -32,16 +32,15 @@ std::vector<Eigen::Isometry3d> MatchPoses(const std::vector<StampedPose>& poses,
     if (stamped == 0) {
         if (poses.size() < scan_times_s.size()) {
             throw FormatError(ScanName(poses.size(), scan_times_s[poses.size()]) +
-                                     " has no pose: " + std::to_string(poses.size()) +
-                                     " poses for " + std::to_string(scan_times_s.size()) +
-                                     " scans");
+                              " has no pose: " + std::to_string(poses.size()) + " poses for " +
+                              std::to_string(scan_times_s.size()) + " scans");
         }
         for (size_t i = 0; i < scan_times_s.size(); ++i) matched.push_back(poses[i].T);
         return matched;
     }
     if (stamped != poses.size()) {
         throw InvalidArgumentError("MatchPoses: only " + std::to_string(stamped) + " of " +
-                                    std::to_string(poses.size()) + " poses have timestamps");
+                                   std::to_string(poses.size()) + " poses have timestamps");
     }
 
     // Poses with timestamps: sort an index by time, then binary-search each scan's time.

@@ -1,5 +1,4 @@
 #include "strata/io/OctomapExport.hpp"
-#include "strata/core/Error.hpp"
 
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
@@ -13,9 +12,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "strata/io/AtomicFile.hpp"
 #include "ExportInput.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 namespace strata::io {
 namespace {
@@ -110,7 +110,7 @@ void WriteOctomap(const core::VoxelMap& map, const std::filesystem::path& path) 
     const std::string ext = LowerExtension(path);
     if (ext != ".bt" && ext != ".ot") {
         throw InvalidArgumentError("cannot write '" + path.string() +
-                                    "' as OctoMap: the extension must be .bt or .ot");
+                                   "' as OctoMap: the extension must be .bt or .ot");
     }
     CheckExtent(map, path);
     if (ext == ".bt") {

@@ -124,9 +124,9 @@ void LayOutFields(const RawPcdHeader& raw, PcdHeader& header, const std::string&
         }
         if (!raw.counts.empty() &&
             (!ParseUint(raw.counts[i], count) || count == 0 || count > kMaxCount)) {
-            FailHeader(file, n,
-                       "field '" + field.name + "' has invalid COUNT " +
-                           std::string(raw.counts[i]));
+            FailHeader(
+                file, n,
+                "field '" + field.name + "' has invalid COUNT " + std::string(raw.counts[i]));
         }
         field.size = static_cast<size_t>(size);
         field.count = static_cast<size_t>(count);

@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "BinaryCursor.hpp"
-#include "strata/core/Error.hpp"
 #include "PcdHeader.hpp"
 #include "ScanBuilder.hpp"
 #include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
@@ -58,15 +58,14 @@ void ReadAsciiPoints(std::string_view text, const PcdHeader& h, const PcdColumns
         const size_t line_number = h.header_lines + lines.line_number();
         if (values.size() != h.values_per_point) {
             throw FormatError(file + ": line " + std::to_string(line_number) + " has " +
-                                     std::to_string(values.size()) + " values, expected " +
-                                     std::to_string(h.values_per_point));
+                              std::to_string(values.size()) + " values, expected " +
+                              std::to_string(h.values_per_point));
         }
         // Every value must parse, used or not: a bad token anywhere means a corrupt file.
         for (size_t k = 0; k < values.size(); ++k) {
             if (!detail::ParseDouble(values[k], row[k])) {
                 throw FormatError(file + ": line " + std::to_string(line_number) +
-                                         ": cannot parse '" + std::string(values[k].substr(0, 40)) +
-                                         "'");
+                                  ": cannot parse '" + std::string(values[k].substr(0, 40)) + "'");
             }
         }
         auto get = [&](int f) { return f >= 0 ? row[column(f)] : 0.0; };
@@ -76,7 +75,7 @@ void ReadAsciiPoints(std::string_view text, const PcdHeader& h, const PcdColumns
     }
     if (read < h.points) {
         throw FormatError(file + ": truncated: " + std::to_string(read) + " of " +
-                                 std::to_string(h.points) + " points in the ascii data");
+                          std::to_string(h.points) + " points in the ascii data");
     }
 }
 

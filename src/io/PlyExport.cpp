@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "strata/io/AtomicFile.hpp"
 #include "ExportInput.hpp"
 #include "strata/core/Labels.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 namespace strata::io {
 namespace {
@@ -49,8 +49,8 @@ std::string Header(const core::VoxelMap& map, uint64_t count, bool use_double) {
 }  // namespace
 
 void WritePly(const core::VoxelMap& map, const std::filesystem::path& path) {
-    WritePly(map, [&](const std::function<void(const core::VoxelMap&)>& visit) { visit(map); },
-             path);
+    WritePly(
+        map, [&](const std::function<void(const core::VoxelMap&)>& visit) { visit(map); }, path);
 }
 
 void WritePly(const core::VoxelMap& frame, const MapParts& parts,

@@ -1,9 +1,9 @@
 #include "PlyHeader.hpp"
-#include "strata/core/Error.hpp"
 
 #include <stdexcept>
 
 #include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::io::detail {
 namespace {

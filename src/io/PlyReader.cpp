@@ -5,10 +5,10 @@
 #include <vector>
 
 #include "BinaryCursor.hpp"
-#include "strata/core/Error.hpp"
 #include "PlyHeader.hpp"
 #include "ScanBuilder.hpp"
 #include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {

@@ -1,5 +1,4 @@
 #include "strata/io/PngExport.hpp"
-#include "strata/core/Error.hpp"
 
 #include <openvdb/tools/ValueTransformer.h>
 
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "ExportInput.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::io {
 namespace {
@@ -136,9 +136,9 @@ TopDownImage RenderTopDown(const core::VoxelMap& map, const TopDownOptions& opti
 
     // Step 2: the top occupied voxel of every column, in parallel over active voxels and tiles.
     // The op must be a non-const lvalue: tools::foreach shares a const op between threads.
-    const int32_t max_k =
-        options.max_z_m ? static_cast<int32_t>(std::floor(*options.max_z_m / map.voxel_size))
-                        : std::numeric_limits<int32_t>::max();
+    const int32_t max_k = options.max_z_m
+                              ? static_cast<int32_t>(std::floor(*options.max_z_m / map.voxel_size))
+                              : std::numeric_limits<int32_t>::max();
     ColumnOp op(map.label->tree(), columns, max_k);
     openvdb::tools::foreach (map.occupancy->cbeginValueOn(), op, /*threaded=*/true,
                              /*shareOp=*/false);

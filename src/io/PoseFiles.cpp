@@ -1,5 +1,4 @@
 #include "strata/io/PoseFiles.hpp"
-#include "strata/core/Error.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -9,6 +8,7 @@
 #include <string_view>
 
 #include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::io {
 namespace {

@@ -1,13 +1,13 @@
 #include "TextParsing.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <cerrno>
 #include <charconv>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <system_error>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::io::detail {
 

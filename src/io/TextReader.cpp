@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "ScanBuilder.hpp"
-#include "strata/core/Error.hpp"
 #include "TextParsing.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
@@ -68,17 +68,16 @@ std::string ReadBzip2File(const std::filesystem::path& path) {
             if (error == BZ_OK || error == BZ_STREAM_END) text.append(chunk.data(), n);
             if (text.size() > limit) {
                 BZ2_bzReadClose(&error, bz);
-                throw FormatError(file + ": decompresses to more than " +
-                                         std::to_string(limit) + " bytes (" +
-                                         std::to_string(kMaxBzip2Ratio) +
-                                         " times the file, at least 64 MiB): not point-cloud text");
+                throw FormatError(file + ": decompresses to more than " + std::to_string(limit) +
+                                  " bytes (" + std::to_string(kMaxBzip2Ratio) +
+                                  " times the file, at least 64 MiB): not point-cloud text");
             }
         }
         if (error != BZ_STREAM_END) {
             int ignored = BZ_OK;
             BZ2_bzReadClose(&ignored, bz);
             throw FormatError(file + ": " + Bzip2Error(error) + " after " +
-                                     std::to_string(text.size()) + " decompressed bytes");
+                              std::to_string(text.size()) + " decompressed bytes");
         }
         void* rest = nullptr;
         int rest_size = 0;
@@ -117,8 +116,7 @@ core::Scan ReadText(const std::filesystem::path& path, const ReadOptions& option
         detail::SplitFields(detail::StripComment(line), fields);
         if (fields.empty()) continue;
         auto fail = [&](const std::string& what) {
-            throw FormatError(file + ": line " + std::to_string(lines.line_number()) + ": " +
-                                     what);
+            throw FormatError(file + ": line " + std::to_string(lines.line_number()) + ": " + what);
         };
         if (columns == 0) {
             if (fields.size() != 3 && fields.size() != 4) {

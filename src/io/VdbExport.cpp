@@ -6,9 +6,9 @@
 #include <array>
 #include <string>
 
-#include "strata/io/AtomicFile.hpp"
 #include "ExportInput.hpp"
 #include "strata/core/Labels.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 namespace strata::io {
 namespace {
@@ -115,8 +115,8 @@ void WriteGrids(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& file_
                 const std::filesystem::path& path) {
     openvdb::initialize();
     // io::Stream into a checked std::ostream: io::File::write reports success on a full disk.
-    WriteFileAtomically(
-        path, [&](std::ostream& os) { openvdb::io::Stream(os).write(grids, file_meta); });
+    WriteFileAtomically(path,
+                        [&](std::ostream& os) { openvdb::io::Stream(os).write(grids, file_meta); });
 }
 
 }  // namespace strata::io

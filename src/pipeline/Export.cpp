@@ -1,5 +1,9 @@
 #include "strata/pipeline/Export.hpp"
 
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <ostream>
+
 #include "strata/core/Error.hpp"
 #include "strata/io/AtomicFile.hpp"
 #include "strata/io/OctomapExport.hpp"
@@ -7,11 +11,6 @@
 #include "strata/io/PngExport.hpp"
 #include "strata/io/VdbExport.hpp"
 #include "strata/store/TileReader.hpp"
-
-#include <nlohmann/json.hpp>
-
-#include <functional>
-#include <ostream>
 
 namespace strata::pipeline {
 
@@ -81,12 +80,13 @@ ExportResult ExportSplit(const store::MapStore& map, const store::TileReader& re
                          const fs::path& out, const ExportOptions& options,
                          const std::string& format) {
     ExportResult result{format, {}, 0};
-    nlohmann::json index = {{"format", format},
-                            {"voxel_size_m", map.settings().voxel_size_m},
-                            {"tile_size_m", map.settings().tile_size_m()},
-                            {"origin", {map.settings().origin.x(), map.settings().origin.y(),
-                                        map.settings().origin.z()}},
-                            {"tiles", nlohmann::json::array()}};
+    nlohmann::json index = {
+        {"format", format},
+        {"voxel_size_m", map.settings().voxel_size_m},
+        {"tile_size_m", map.settings().tile_size_m()},
+        {"origin",
+         {map.settings().origin.x(), map.settings().origin.y(), map.settings().origin.z()}},
+        {"tiles", nlohmann::json::array()}};
     ExportOptions one = options;
     one.format = format;
     for (const store::TileKey& key : reader.Tiles()) {
@@ -97,10 +97,11 @@ ExportResult ExportSplit(const store::MapStore& map, const store::TileReader& re
         (void)ExportMap(*tile, file, one);
         result.files.push_back(file);
         const double t = map.settings().tile_size_m();
-        index["tiles"].push_back({{"x", key.x},
-                                  {"y", key.y},
-                                  {"file", file.filename().string()},
-                                  {"bounds_m", {key.x * t, key.y * t, (key.x + 1) * t, (key.y + 1) * t}}});
+        index["tiles"].push_back(
+            {{"x", key.x},
+             {"y", key.y},
+             {"file", file.filename().string()},
+             {"bounds_m", {key.x * t, key.y * t, (key.x + 1) * t, (key.y + 1) * t}}});
     }
     const fs::path index_file = out.parent_path() / (out.stem().string() + ".tiles.json");
     io::WriteFileAtomically(index_file, [&](std::ostream& os) { os << index.dump(2) << "\n"; });
@@ -132,11 +133,13 @@ ExportResult ExportStored(const store::MapStore& map, const store::Snapshot& sna
     }
     const uint64_t bytes = map.Bytes(snapshot).fused_current;
     if (options.memory_budget_bytes > 0 && bytes > options.memory_budget_bytes) {
-        throw RefusedError(map.dir().string() + ": its fused grids (" +
-                           std::to_string(bytes / 1000000) + " MB on disk) exceed the memory "
-                           "budget (" + std::to_string(options.memory_budget_bytes / 1000000) +
-                           " MB) for one " + format + " file; export one file per tile with "
-                           "--split, or raise --memory-budget");
+        throw RefusedError(
+            map.dir().string() + ": its fused grids (" + std::to_string(bytes / 1000000) +
+            " MB on disk) exceed the memory "
+            "budget (" +
+            std::to_string(options.memory_budget_bytes / 1000000) + " MB) for one " + format +
+            " file; export one file per tile with "
+            "--split, or raise --memory-budget");
     }
     (void)ExportMap(map.LoadMap(snapshot), out, options);
     return {format, {out}, snapshot.tiles.size()};

@@ -104,7 +104,7 @@ nlohmann::json DescribeMap(const store::MapStore& store, const std::string& as_o
     j["memory_bytes"] = all.memory;
     const store::StorageBytes bytes = store.Bytes(snapshot);
     j["tiles"] = snapshot.tiles.size();
-    j["tile_bytes"] = bytes.fused_current;  // the fused files this snapshot reads
+    j["tile_bytes"] = bytes.fused_current;       // the fused files this snapshot reads
     j["tile_versions"] = store.TileFileCount();  // every fused version kept, history included
     j["history_start_commit"] = store.HistoryStart();
     j["bytes"] = {{"fused_current", bytes.fused_current},
@@ -115,9 +115,13 @@ nlohmann::json DescribeMap(const store::MapStore& store, const std::string& as_o
     j["disk_bytes"] = DiskUse(store.dir());  // catalog, all files, garbage
     j["sessions"] = nlohmann::json::array();
     for (const auto& s : snapshot.sessions) {
-        j["sessions"].push_back({{"id", s.id}, {"name", s.name}, {"source", s.source},
-                                 {"scans", s.scans}, {"points", s.points},
-                                 {"start_utc", s.start_utc}, {"end_utc", s.end_utc},
+        j["sessions"].push_back({{"id", s.id},
+                                 {"name", s.name},
+                                 {"source", s.source},
+                                 {"scans", s.scans},
+                                 {"points", s.points},
+                                 {"start_utc", s.start_utc},
+                                 {"end_utc", s.end_utc},
                                  {"commit", s.commit}});
     }
     return j;

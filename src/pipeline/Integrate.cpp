@@ -2,8 +2,8 @@
 
 #include <chrono>
 #include <iomanip>
-#include <sstream>
 #include <optional>
+#include <sstream>
 
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/NewSession.hpp"
@@ -119,8 +119,8 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
         const char* stage = "integrating";
         if (ranks.root()) ReportProgress(options.progress, stage, 0, source->size());
         const RankedSessionResult r = IntegrateOnRanks(
-            map, source->size(), [&](size_t i) { return source->Read(i); }, opened->rule,
-            session, ranks,
+            map, source->size(), [&](size_t i) { return source->Read(i); }, opened->rule, session,
+            ranks,
             [&](size_t done) { ReportProgress(options.progress, stage, done, source->size()); });
         result.session = r.session;
         result.stats = r.stats;

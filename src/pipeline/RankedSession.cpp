@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <exception>
 #include <memory>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "strata/core/Error.hpp"
 #include "strata/integration/UpdateParts.hpp"
@@ -28,13 +28,20 @@ char KindOf(const std::exception& e) {
 
 [[noreturn]] void ThrowKind(char kind, const std::string& what) {
     switch (kind) {
-        case 'A': throw InvalidArgumentError(what);
-        case 'F': throw FormatError(what);
-        case 'N': throw NotFoundError(what);
-        case 'L': throw MapLockedError(what);
-        case 'R': throw RefusedError(what);
-        case 'I': throw IoError(what);
-        default: throw Error(what);
+        case 'A':
+            throw InvalidArgumentError(what);
+        case 'F':
+            throw FormatError(what);
+        case 'N':
+            throw NotFoundError(what);
+        case 'L':
+            throw MapLockedError(what);
+        case 'R':
+            throw RefusedError(what);
+        case 'I':
+            throw IoError(what);
+        default:
+            throw Error(what);
     }
 }
 
@@ -73,8 +80,8 @@ store::ScanRecord RecordFrom(const json& j) {
 }
 
 json FileJson(const store::FileRef& f, const store::TileKey& key) {
-    return {{"file", f.file}, {"bytes", f.bytes}, {"checksum", f.checksum}, {"x", key.x},
-            {"y", key.y}};
+    return {
+        {"file", f.file}, {"bytes", f.bytes}, {"checksum", f.checksum}, {"x", key.x}, {"y", key.y}};
 }
 
 template <typename T>
@@ -98,8 +105,8 @@ std::string FilesText(const store::SessionFiles& files) {
         j["layers"].back()["session"] = l.session;
     }
     const store::WriterStats& s = files.stats;
-    j["stats"] = {s.tiles_loaded, s.tiles_evicted, s.tiles_written, s.layers_written,
-                  s.bytes_written, s.peak_memory_bytes};
+    j["stats"] = {s.tiles_loaded,   s.tiles_evicted, s.tiles_written,
+                  s.layers_written, s.bytes_written, s.peak_memory_bytes};
     return j.dump();
 }
 
@@ -130,8 +137,8 @@ void AddStats(store::WriterStats& sum, const store::WriterStats& s) {
 }
 
 json SessionJson(const store::SessionRecord& s) {
-    return {{"id", s.id},         {"name", s.name},     {"commit", s.commit},
-            {"scans", s.scans},   {"points", s.points}, {"start_utc", s.start_utc},
+    return {{"id", s.id},          {"name", s.name},     {"commit", s.commit},
+            {"scans", s.scans},    {"points", s.points}, {"start_utc", s.start_utc},
             {"end_utc", s.end_utc}};
 }
 
@@ -166,7 +173,8 @@ void OnEveryRank(const Ranks& ranks, const std::function<void()>& step) {
     first = ranks.Broadcast(first);
     if (mine) std::rethrow_exception(mine);
     const size_t space = first.find(' ');
-    ThrowKind(first.at(space + 1), "rank " + first.substr(0, space) + ": " + first.substr(space + 2));
+    ThrowKind(first.at(space + 1),
+              "rank " + first.substr(0, space) + ": " + first.substr(space + 2));
 }
 
 store::MapStore OpenOnRanks(const std::filesystem::path& dir, const Ranks& ranks,
@@ -188,7 +196,8 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
                                      const std::function<void(size_t)>& progress) {
     const int n = ranks.size();
     const int me = ranks.rank();
-    if (n > 1) options.owns = [n, me](const store::TileKey& key) { return TileOwner(key, n) == me; };
+    if (n > 1)
+        options.owns = [n, me](const store::TileKey& key) { return TileOwner(key, n) == me; };
     // The committer's writer names the session; the others write their tiles for it.
     std::unique_ptr<store::SessionWriter> writer;
     OnEveryRank(ranks, [&] {
@@ -219,7 +228,8 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
                                            return TileOwner(map.settings().TileOf(leaf), n) == d;
                                        })));
                     if (d == 0) {
-                        AppendPiece(m, RecordJson(store::SessionWriter::RecordOf(scan, update)).dump());
+                        AppendPiece(
+                            m, RecordJson(store::SessionWriter::RecordOf(scan, update)).dump());
                     }
                 }
             });
@@ -254,10 +264,11 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
         result.stats = writer->stats();
         for (const auto& w : workers) AddStats(result.stats, w.stats);
     });
-    const json session = json::parse(ranks.Broadcast(
-        ranks.root() ? json{{"session", SessionJson(result.session)},
-                            {"stats", FilesText({{}, {}, result.stats})}}.dump()
-                     : ""));
+    const json session = json::parse(
+        ranks.Broadcast(ranks.root() ? json{{"session", SessionJson(result.session)},
+                                            {"stats", FilesText({{}, {}, result.stats})}}
+                                           .dump()
+                                     : ""));
     if (!ranks.root()) {
         const json& s = session.at("session");
         result.session.id = s.at("id").get<int64_t>();

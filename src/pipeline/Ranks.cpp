@@ -83,7 +83,8 @@ std::vector<std::string> Ranks::Exchange(const std::vector<std::string>& out) co
     MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
     const size_t total = std::accumulate(recv_counts.begin(), recv_counts.end(), size_t{0});
     std::string recv(total, '\0');
-    const std::vector<int> send_offsets = Displacements(send_counts), recv_offsets = Displacements(recv_counts);
+    const std::vector<int> send_offsets = Displacements(send_counts),
+                           recv_offsets = Displacements(recv_counts);
     (void)MessageBytes(send.size());
     (void)MessageBytes(total);
     MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_CHAR, recv.data(),

@@ -1,5 +1,4 @@
 #include "EmbreeScene.hpp"
-#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -7,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::sim {
 namespace {
@@ -43,12 +44,15 @@ Eigen::Vector3f ClosestOnTriangle(const Eigen::Vector3f& p, const Eigen::Vector3
 bool ClosestTriangle(RTCPointQueryFunctionArguments* args) {
     auto* scene = static_cast<RTCScene>(args->userPtr);
     RTCGeometry geom = rtcGetGeometry(scene, args->geomID);
-    const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
-    const auto* t = static_cast<const uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+    const auto* v =
+        static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    const auto* t =
+        static_cast<const uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
     const uint32_t* tri = t + 3 * args->primID;
     auto vertex = [&](uint32_t k) { return Eigen::Vector3f(v[3 * k], v[3 * k + 1], v[3 * k + 2]); };
     const Eigen::Vector3f p(args->query->x, args->query->y, args->query->z);
-    const float d = (ClosestOnTriangle(p, vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) - p).norm();
+    const float d =
+        (ClosestOnTriangle(p, vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) - p).norm();
     if (d >= args->query->radius) return false;
     args->query->radius = d;
     return true;

@@ -1,9 +1,10 @@
 #include "strata/sim/KittiIds.hpp"
-#include "strata/core/Error.hpp"
 
 #include <array>
 #include <cctype>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::sim::kitti {
 namespace {

@@ -1,7 +1,7 @@
 #include <stdexcept>
 
-#include "strata/io/Image.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/io/Image.hpp"
 #include "strata/sim/ScenePicture.hpp"
 
 namespace strata::sim {
@@ -10,7 +10,7 @@ void WritePicturePng(const std::filesystem::path& path, const Picture& picture) 
     if (picture.width <= 0 || picture.height <= 0 ||
         picture.rgb.size() != size_t(picture.width) * size_t(picture.height) * 3) {
         throw InvalidArgumentError("cannot write an empty or malformed picture to " +
-                                    path.string());
+                                   path.string());
     }
     io::RgbImage image(picture.width, picture.height);
     for (int y = 0; y < picture.height; ++y) {

@@ -1,5 +1,4 @@
 #include "strata/sim/ScenePicture.hpp"
-#include "strata/core/Error.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -8,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/sim/KittiIds.hpp"
 #include "strata/sim/Simulator.hpp"
 

@@ -1,8 +1,9 @@
 #include "strata/sim/SensorModel.hpp"
-#include "strata/core/Error.hpp"
 
 #include <cmath>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::sim {
 namespace {

@@ -1,5 +1,4 @@
 #include "strata/sim/SequenceWriter.hpp"
-#include "strata/core/Error.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -7,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
 
@@ -41,9 +41,7 @@ SequenceWriter::SequenceWriter(std::filesystem::path dir) : dir_(std::move(dir))
     std::error_code ec;
     for (const char* sub : {"velodyne", "labels"}) {
         std::filesystem::create_directories(dir_ / sub, ec);
-        if (ec)
-            throw IoError("cannot create " + (dir_ / sub).string() + ": " +
-                                     ec.message());
+        if (ec) throw IoError("cannot create " + (dir_ / sub).string() + ": " + ec.message());
     }
 }
 

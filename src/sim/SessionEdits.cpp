@@ -1,5 +1,4 @@
 #include "SessionEdits.hpp"
-#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +6,7 @@
 #include "MeshBuilders.hpp"
 #include "ObjectGeometry.hpp"
 #include "WallGeometry.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::sim::detail {
 namespace {

@@ -1,5 +1,4 @@
 #include "strata/sim/SurfaceScore.hpp"
-#include "strata/core/Error.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -10,6 +9,7 @@
 #include <unordered_map>
 
 #include "EmbreeScene.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::sim {
 

@@ -55,7 +55,7 @@ struct SweepContext {
     const EmbreeScene& embree;
     const std::vector<float>& reflectivity;  // per mesh
     const SensorModel& sensor;
-    std::vector<float> cos_el, sin_el;       // per beam
+    std::vector<float> cos_el, sin_el;  // per beam
     uint64_t key;
 
     SweepContext(const EmbreeScene& embree_scene, const std::vector<float>& mesh_reflectivity,

@@ -1,10 +1,10 @@
 #include "strata/sim/Trajectory.hpp"
-#include "strata/core/Error.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/sim/Simulator.hpp"
 
 namespace strata::sim {
@@ -75,7 +75,7 @@ std::vector<ScanPose> PlanScanPoses(const TrajectorySpec& trajectory, const Simu
             const std::optional<double> ground = simulator.GroundHeight(w.x(), w.y(), 1e3);
             if (!ground) {
                 throw InvalidArgumentError("no ground under waypoint (" + std::to_string(w.x()) +
-                                            ", " + std::to_string(w.y()) + ")");
+                                           ", " + std::to_string(w.y()) + ")");
             }
             floor_z = *ground;
         }

@@ -1,8 +1,8 @@
 #include <stdexcept>
 
 #include "MeshBuilders.hpp"
-#include "strata/core/Error.hpp"
 #include "ObjectGeometry.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/sim/KittiIds.hpp"
 
 namespace strata::sim::detail {

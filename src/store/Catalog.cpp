@@ -1,13 +1,13 @@
 #include "Catalog.hpp"
 
-#include "IntegrationRule.hpp"
-#include "strata/core/Error.hpp"
-
 #include <cinttypes>
 #include <cstdio>
 #include <ctime>
 #include <sstream>
 #include <stdexcept>
+
+#include "IntegrationRule.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::store::detail {
 namespace {
@@ -171,8 +171,8 @@ std::vector<SessionRecord> ReadSessions(const Database& db, int64_t commit) {
 }
 
 std::vector<std::pair<SessionRecord, int64_t>> ReadSessionHistory(const Database& db) {
-    Statement q(db, (std::string("SELECT ") + kSessionColumns + " FROM sessions ORDER BY id")
-                        .c_str());
+    Statement q(db,
+                (std::string("SELECT ") + kSessionColumns + " FROM sessions ORDER BY id").c_str());
     std::vector<std::pair<SessionRecord, int64_t>> out;
     while (q.Step()) out.emplace_back(SessionFromRow(q, db), q.Int(11));
     return out;

@@ -25,8 +25,7 @@ int64_t InsertCommit(const Database& db, const std::string& kind, int64_t sessio
 /// Sessions alive at `commit`.
 [[nodiscard]] std::vector<SessionRecord> ReadSessions(const Database& db, int64_t commit);
 /// Every session with the commit that removed it (0 when alive).
-[[nodiscard]] std::vector<std::pair<SessionRecord, int64_t>> ReadSessionHistory(
-    const Database& db);
+[[nodiscard]] std::vector<std::pair<SessionRecord, int64_t>> ReadSessionHistory(const Database& db);
 int64_t InsertSession(const Database& db, const SessionRecord& session);
 void MarkSessionRemoved(const Database& db, int64_t session_id, int64_t commit);
 void InsertScans(const Database& db, int64_t session_id, const std::vector<ScanRecord>& scans);

@@ -1,6 +1,5 @@
 #include "Format4.hpp"
 
-
 #include <map>
 #include <set>
 #include <sstream>
@@ -36,8 +35,9 @@ struct CommitInfo {
 };
 
 // Splits the versions of one tile, oldest first; appends what it wrote to `out`.
-void SplitTile(const std::vector<TileVersion>& versions, const std::map<int64_t, CommitInfo>& commits,
-               const fs::path& dir, Format5Files& out) {
+void SplitTile(const std::vector<TileVersion>& versions,
+               const std::map<int64_t, CommitInfo>& commits, const fs::path& dir,
+               Format5Files& out) {
     uint64_t previous = 0;  // checksum of the previous version's new fused file (0: none)
     for (const TileVersion& v : versions) {
         Format5Files::Version next{v.key, v.version, {}, false};
@@ -94,7 +94,8 @@ void SplitTile(const std::vector<TileVersion>& versions, const std::map<int64_t,
             p.key = v.key;
             p.commit = v.commit;
             p.kind = commit.kind;
-            static_cast<FileRef&>(p) = WriteGrids(dir, ProductFileName(v.key, v.commit), products, v.key);
+            static_cast<FileRef&>(p) =
+                WriteGrids(dir, ProductFileName(v.key, v.commit), products, v.key);
             out.products.push_back(p);
         }
     }
@@ -113,9 +114,8 @@ Format5Files WriteFormat5Files(const Database& db, const fs::path& map_dir) {
     const std::vector<std::pair<TileKey, std::vector<TileVersion>>> tiles(by_tile.begin(),
                                                                           by_tile.end());
     std::vector<Format5Files> parts(tiles.size());
-    core::ParallelFor(tiles.size(), [&](size_t i) {
-        SplitTile(tiles[i].second, commits, map_dir, parts[i]);
-    });
+    core::ParallelFor(tiles.size(),
+                      [&](size_t i) { SplitTile(tiles[i].second, commits, map_dir, parts[i]); });
     Format5Files out;
     for (Format5Files& p : parts) {
         out.versions.insert(out.versions.end(), p.versions.begin(), p.versions.end());

@@ -41,7 +41,8 @@ std::vector<Referenced> ReferencedFiles(const MapStore& store, const detail::Dat
 }
 
 // Files under tiles/ outside `referenced`, sorted.
-std::vector<std::string> Unreferenced(const fs::path& dir, const std::set<std::string>& referenced) {
+std::vector<std::string> Unreferenced(const fs::path& dir,
+                                      const std::set<std::string>& referenced) {
     std::vector<std::string> out;
     std::error_code ec;
     for (auto it = fs::recursive_directory_iterator(dir / "tiles", ec);
@@ -106,8 +107,9 @@ int64_t KeptFrom(const std::vector<std::pair<int64_t, std::string>>& commits,
 
 void HistoryPolicy::Validate() const {
     if ((keep_last > 0) == !keep_since_utc.empty()) {
-        throw InvalidArgumentError("give exactly one of --keep-last N (N >= 1) and --keep-since "
-                                   "DATE");
+        throw InvalidArgumentError(
+            "give exactly one of --keep-last N (N >= 1) and --keep-since "
+            "DATE");
     }
     static const std::regex kDate(R"(\d{4}-\d{2}-\d{2}(T\d{2}:\d{2}(:\d{2}(\.\d+)?)?Z?)?)");
     if (!keep_since_utc.empty() && !std::regex_match(keep_since_utc, kDate)) {

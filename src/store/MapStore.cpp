@@ -126,9 +126,9 @@ Snapshot MapStore::AsOf(int64_t session_id) const {
 
 int64_t MapStore::FindSession(const std::string& id_or_name) const {
     const auto history = SessionHistory();
-    const bool numeric = !id_or_name.empty() &&
-                         std::all_of(id_or_name.begin(), id_or_name.end(),
-                                     [](char c) { return c >= '0' && c <= '9'; });
+    const bool numeric =
+        !id_or_name.empty() && std::all_of(id_or_name.begin(), id_or_name.end(),
+                                           [](char c) { return c >= '0' && c <= '9'; });
     // Names may repeat: the newest live session with the name wins, then the newest removed one.
     for (const bool want_alive : {true, false}) {
         for (auto it = history.rbegin(); it != history.rend(); ++it) {
@@ -190,7 +190,8 @@ core::VoxelMap MapStore::ReadFused(const TileVersion& version) const {
 }
 
 SessionLayer MapStore::ReadLayer(const LayerFile& layer) const {
-    const std::string bytes = detail::ReadVerifiedFile(impl_->dir, layer, detail::FileKind::kLayers);
+    const std::string bytes =
+        detail::ReadVerifiedFile(impl_->dir, layer, detail::FileKind::kLayers);
     return detail::DecodeLayer(bytes, layer.key, layer.session, impl_->dir / layer.file);
 }
 

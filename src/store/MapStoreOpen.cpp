@@ -42,8 +42,8 @@ int TakeWriterLock(const fs::path& dir) {
     const fs::path file = dir / kLockFile;
     const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0) {
-        throw IoError(dir.string() + ": cannot open " + kLockFile + " (" +
-                                 std::strerror(errno) + ")");
+        throw IoError(dir.string() + ": cannot open " + kLockFile + " (" + std::strerror(errno) +
+                      ")");
     }
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
         char pid[32] = {};
@@ -52,9 +52,9 @@ int TakeWriterLock(const fs::path& dir) {
         std::string holder = n > 0 ? std::string(pid, static_cast<size_t>(n)) : "";
         holder.erase(std::remove(holder.begin(), holder.end(), '\n'), holder.end());
         throw MapLockedError(dir.string() + ": another strata process" +
-                                 (holder.empty() ? "" : " (pid " + holder + ")") +
-                                 " is writing this map; one writer at a time, try again when it "
-                                 "has finished");
+                             (holder.empty() ? "" : " (pid " + holder + ")") +
+                             " is writing this map; one writer at a time, try again when it "
+                             "has finished");
     }
     const std::string pid = std::to_string(::getpid()) + "\n";
     if (::ftruncate(fd, 0) != 0 ||
@@ -112,7 +112,8 @@ void RequireMapDirectory(const fs::path& dir) {
     }
     std::error_code ec;
     if (!fs::is_empty(dir, ec) && !ec && OnlyCreationLeftovers(dir)) {
-        throw FormatError(dir.string() + ": not a strata map: its creation was interrupted "
+        throw FormatError(dir.string() +
+                          ": not a strata map: its creation was interrupted "
                           "(run `strata integrate` on it again)");
     }
     throw FormatError(dir.string() + ": not a strata map (no " + kCatalog + ")");
@@ -156,7 +157,8 @@ MapStore MapStore::Create(const fs::path& dir, const StoreSettings& settings) {
     fs::create_directories(dir, ec);
     if (ec) throw IoError(dir.string() + ": cannot create (" + ec.message() + ")");
     const auto refuse = [&] {
-        throw InvalidArgumentError(dir.string() + ": exists and is neither empty nor a map "
+        throw InvalidArgumentError(dir.string() +
+                                   ": exists and is neither empty nor a map "
                                    "whose creation was interrupted");
     };
     if (fs::exists(dir / kCatalog) || !OnlyCreationLeftovers(dir)) refuse();

@@ -45,9 +45,9 @@ void RequireRows(const std::vector<std::string>& rows, const detail::Database& d
     for (size_t i = 0; i < rows.size(); ++i) {
         q.Bind(1, rows[i]);
         if (!q.Step() || q.Int(0) != 1) {
-            throw InvalidArgumentError("product row " + std::to_string(i) +
-                                       " is not a JSON object without 'id' and 'commit_id': " +
-                                       rows[i].substr(0, 80));
+            throw InvalidArgumentError(
+                "product row " + std::to_string(i) +
+                " is not a JSON object without 'id' and 'commit_id': " + rows[i].substr(0, 80));
         }
         q.Reset();
     }
@@ -63,8 +63,8 @@ std::set<TileKey> TilesOf(const openvdb::GridPtrVec& grids, const MapSettings& s
             }
         });
         if (!voxels) {
-            throw InvalidArgumentError("product grid '" + g->getName() + "' has type " +
-                                       g->type() + ", not a stock voxel grid");
+            throw InvalidArgumentError("product grid '" + g->getName() + "' has type " + g->type() +
+                                       ", not a stock voxel grid");
         }
     }
     return keys;
@@ -130,7 +130,8 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
                 p.key = key;
                 p.kind = product.kind;
                 written.push_back(detail::ProductFileName(key, commit_id));
-                static_cast<FileRef&>(p) = detail::WriteGrids(impl.dir, written.back(), pieces, key);
+                static_cast<FileRef&>(p) =
+                    detail::WriteGrids(impl.dir, written.back(), pieces, key);
                 files.push_back(p);
             }
             const auto e = edited.find(key);
@@ -181,29 +182,32 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
 }
 
 std::vector<ProductRow> MapStore::ProductRows(const std::string& kind) const {
-    return SelectRows(*impl_->db,
-                      "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
-                      "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
-                      "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1) ORDER BY r.id",
-                      kind);
+    return SelectRows(
+        *impl_->db,
+        "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
+        "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
+        "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1) ORDER BY r.id",
+        kind);
 }
 
 std::vector<ProductRow> MapStore::ProductRowsAt(const std::string& kind, int64_t commit) const {
     // The newest commit of the kind is found in `commits`, not among the rows: a commit that
     // stored no row (no wall found) replaces the rows before it all the same.
-    return SelectRows(*impl_->db,
-                      "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
-                      "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
-                      "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1 AND id <= ?2) "
-                      "ORDER BY r.id",
-                      kind, commit);
+    return SelectRows(
+        *impl_->db,
+        "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
+        "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 AND "
+        "r.commit_id = (SELECT MAX(id) FROM commits WHERE kind = ?1 AND id <= ?2) "
+        "ORDER BY r.id",
+        kind, commit);
 }
 
 std::vector<ProductRow> MapStore::ProductHistory(const std::string& kind) const {
-    return SelectRows(*impl_->db,
-                      "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
-                      "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 ORDER BY r.id",
-                      kind);
+    return SelectRows(
+        *impl_->db,
+        "SELECT r.id, r.commit_id, COALESCE(c.time_utc, ''), r.row FROM product_rows r "
+        "LEFT JOIN commits c ON c.id = r.commit_id WHERE r.kind = ?1 ORDER BY r.id",
+        kind);
 }
 
 }  // namespace strata::store

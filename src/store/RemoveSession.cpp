@@ -23,10 +23,10 @@ namespace fs = std::filesystem;
 // One vote of a session over `seen`: hit where it saw the voxel occupied, miss where free.
 integration::ScanUpdate Votes(const SessionLayer& layer, const openvdb::BoolTree& seen) {
     integration::ScanUpdate u;
-    u.occupied = std::make_shared<openvdb::MaskTree>(layer.occupied->tree(), false,
-                                                     openvdb::TopologyCopy());
-    u.free = std::make_shared<openvdb::MaskTree>(layer.free->tree(), false,
-                                                 openvdb::TopologyCopy());
+    u.occupied =
+        std::make_shared<openvdb::MaskTree>(layer.occupied->tree(), false, openvdb::TopologyCopy());
+    u.free =
+        std::make_shared<openvdb::MaskTree>(layer.free->tree(), false, openvdb::TopologyCopy());
     u.occupied->topologyIntersection(seen);
     u.free->topologyIntersection(seen);
     return u;

@@ -1,11 +1,11 @@
 #include "strata/store/SessionWriter.hpp"
 
+#include <openvdb/tools/Prune.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <chrono>
 #include <map>
-#include <openvdb/tools/Prune.h>
 #include <optional>
 #include <set>
 #include <tuple>
@@ -16,8 +16,8 @@
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
 #include "strata/core/Error.hpp"
-#include "strata/core/ParallelFor.hpp"
 #include "strata/core/OccupancyMasks.hpp"
+#include "strata/core/ParallelFor.hpp"
 #include "strata/integration/UpdateParts.hpp"
 
 namespace strata::store {
@@ -33,8 +33,8 @@ openvdb::GridPtrVec LayerGrids(int64_t session, const openvdb::FloatGrid& logodd
     masks.free->setName(detail::LayerName(session, false));
     for (auto* grid : {masks.occupied.get(), masks.free.get()}) {
         grid->setGridClass(openvdb::GRID_UNKNOWN);
-        grid->insertMeta("units", openvdb::StringMetadata("seen by session " +
-                                                          std::to_string(session)));
+        grid->insertMeta("units",
+                         openvdb::StringMetadata("seen by session " + std::to_string(session)));
     }
     return {masks.occupied, masks.free};
 }
@@ -84,9 +84,7 @@ struct SessionWriter::State {
         return (it == last_versions.end() ? 0 : it->second) + 1;
     }
 
-    [[nodiscard]] bool Owns(const TileKey& key) const {
-        return !options.owns || options.owns(key);
-    }
+    [[nodiscard]] bool Owns(const TileKey& key) const { return !options.owns || options.owns(key); }
 
     std::set<TileKey> TouchedTiles(const integration::ScanUpdate& update) const {
         std::set<TileKey> keys;
@@ -159,7 +157,8 @@ struct SessionWriter::State {
             const auto grids = detail::DecodeGrids(
                 detail::ReadVerifiedFile(impl.dir, lo, detail::FileKind::kLayers), key,
                 impl.dir / lo.file);
-            out.logodds = grids.empty() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(grids[0]);
+            out.logodds =
+                grids.empty() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(grids[0]);
             if (!out.logodds) throw FormatError((impl.dir / lo.file).string() + ": no log-odds");
         } else if (const auto c = committed.find(key); c != committed.end()) {
             out.fused = store.ReadFused(c->second);
@@ -201,9 +200,9 @@ struct SessionWriter::State {
         l.key = key;
         l.session = session_id;
         if (logodds.activeVoxelCount() > 0) {
-            static_cast<FileRef&>(l) = detail::WriteGrids(
-                impl.dir, detail::LayerFileName(key, session_id), LayerGrids(session_id, logodds),
-                key);
+            static_cast<FileRef&>(l) =
+                detail::WriteGrids(impl.dir, detail::LayerFileName(key, session_id),
+                                   LayerGrids(session_id, logodds), key);
         }
         return {v, l};
     }
@@ -292,7 +291,8 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
         for (const std::string& c : conflicts) what += (what.empty() ? "" : "; ") + c;
         throw InvalidArgumentError(s.impl.dir.string() +
                                    ": the integration settings differ from the rule the map was "
-                                   "built with (" + what + ")");
+                                   "built with (" +
+                                   what + ")");
     }
     s.session_id = s.options.worker_of_session > 0 ? s.options.worker_of_session
                                                    : detail::NextSessionId(*s.impl.db);
@@ -389,8 +389,9 @@ SessionRecord SessionWriter::Commit(const std::vector<SessionFiles>& workers) {
     State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
     if (s.options.worker_of_session > 0) {
-        throw InvalidArgumentError("a worker of a session writes its files (WriteFiles); the "
-                                   "process holding the writer lock commits them");
+        throw InvalidArgumentError(
+            "a worker of a session writes its files (WriteFiles); the "
+            "process holding the writer lock commits them");
     }
     const auto start = std::chrono::steady_clock::now();
     // On failure the workers' files go with this writer's: nothing will reference them.

@@ -1,6 +1,7 @@
 #include "TileFile.hpp"
 
 #include <fcntl.h>
+#include <openvdb/io/Stream.h>
 #include <unistd.h>
 #include <xxhash.h>
 
@@ -9,7 +10,6 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <openvdb/io/Stream.h>
 #include <sstream>
 
 #include "strata/core/Error.hpp"

@@ -1,6 +1,5 @@
 #include "strata/store/TileReader.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 #include <list>
@@ -119,9 +118,9 @@ std::vector<TileKey> TileReader::SessionTiles(int64_t session) const {
 }
 
 std::shared_ptr<const core::VoxelMap> TileReader::Fused(const TileKey& key) const {
-    const auto it = std::lower_bound(
-        snapshot_.tiles.begin(), snapshot_.tiles.end(), key,
-        [](const TileVersion& v, const TileKey& k) { return v.key < k; });
+    const auto it =
+        std::lower_bound(snapshot_.tiles.begin(), snapshot_.tiles.end(), key,
+                         [](const TileVersion& v, const TileKey& k) { return v.key < k; });
     if (it == snapshot_.tiles.end() || it->key != key) return nullptr;
     return cache_->Get<core::VoxelMap>(it->file, [&] {
         auto map = std::make_shared<const core::VoxelMap>(store_->ReadFused(*it));
@@ -130,8 +129,9 @@ std::shared_ptr<const core::VoxelMap> TileReader::Fused(const TileKey& key) cons
 }
 
 std::shared_ptr<const SessionLayer> TileReader::Layers(const TileKey& key, int64_t session) const {
-    const auto it = std::find_if(snapshot_.layers.begin(), snapshot_.layers.end(),
-                                 [&](const LayerFile& l) { return l.session == session && l.key == key; });
+    const auto it =
+        std::find_if(snapshot_.layers.begin(), snapshot_.layers.end(),
+                     [&](const LayerFile& l) { return l.session == session && l.key == key; });
     if (it == snapshot_.layers.end()) return nullptr;
     return cache_->Get<SessionLayer>(it->file, [&] {
         auto layer = std::make_shared<const SessionLayer>(store_->ReadLayer(*it));
@@ -141,8 +141,9 @@ std::shared_ptr<const SessionLayer> TileReader::Layers(const TileKey& key, int64
 }
 
 openvdb::GridPtrVec TileReader::Products(const TileKey& key, const std::string& kind) const {
-    const auto it = std::find_if(snapshot_.products.begin(), snapshot_.products.end(),
-                                 [&](const ProductFile& p) { return p.kind == kind && p.key == key; });
+    const auto it =
+        std::find_if(snapshot_.products.begin(), snapshot_.products.end(),
+                     [&](const ProductFile& p) { return p.kind == kind && p.key == key; });
     if (it == snapshot_.products.end()) return {};
     return *cache_->Get<openvdb::GridPtrVec>(it->file, [&] {
         auto grids = std::make_shared<const openvdb::GridPtrVec>(store_->ReadProduct(*it));

@@ -12,15 +12,16 @@ namespace strata::store::detail {
 
 /// The stock voxel grid types a map or a product may use (OpenVDB's GridTypes without the point
 /// grids, whose instantiation only costs compile time here).
-using VoxelGridTypes = openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<
-    openvdb::BoolGrid, openvdb::MaskGrid>;
+using VoxelGridTypes =
+    openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<openvdb::BoolGrid,
+                                                                      openvdb::MaskGrid>;
 
 /// Moves every leaf of `from` that lies in one of `keys` (every leaf when `keys` is null) into a
 /// grid per tile, which shares `from`'s transform and metadata; every key of `keys` gets a grid.
 /// Active tiles above leaf level must not exist (VoxelizeTiles).
 template <typename GridT>
 std::map<TileKey, typename GridT::Ptr> StealTiles(GridT& from, const MapSettings& settings,
-                                                   const std::set<TileKey>* keys) {
+                                                  const std::set<TileKey>* keys) {
     using LeafT = typename GridT::TreeType::LeafNodeType;
     std::vector<std::pair<TileKey, openvdb::Coord>> leaves;
     for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {

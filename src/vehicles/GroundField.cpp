@@ -1,11 +1,10 @@
 #include "strata/vehicles/GroundField.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::vehicles {

@@ -1,11 +1,11 @@
 #include "strata/vehicles/LShapeFit.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::vehicles {
 

@@ -1,11 +1,11 @@
 #include "OcclusionScene.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <array>
 #include <limits>
 #include <stdexcept>
 #include <utility>
+
+#include "strata/core/Error.hpp"
 
 namespace strata::vehicles::detail {
 
@@ -50,7 +50,7 @@ OcclusionScene::OcclusionScene(const std::vector<openvdb::Coord>& voxels, double
     device_ = rtcNewDevice("verbose=0");
     if (device_ == nullptr) {
         throw Error("Embree: cannot create a device (error " +
-                                 std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+                    std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     }
     scene_ = rtcNewScene(device_);
     if (scene_ == nullptr) Fail("cannot create a scene");

@@ -241,8 +241,8 @@ void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& grou
         const double offset = c.z - map.VoxelCenter(c.ijk).z();
         // The refilled height as the voxel's point mean; its hit count (no points) is kept.
         const int32_t hits = core::endpoint::Hits(endpoints.getValue(c.ijk));
-        endpoints.setValue(c.ijk, core::endpoint::Pack(hits, Eigen::Vector3d(0.0, 0.0, offset),
-                                                       map.voxel_size));
+        endpoints.setValue(
+            c.ijk, core::endpoint::Pack(hits, Eigen::Vector3d(0.0, 0.0, offset), map.voxel_size));
         mark.setValue(c.ijk, static_cast<float>(c.z));
         ++vehicle.refilled_cells;
     }

@@ -1,12 +1,11 @@
 #include "strata/vehicles/Vehicles.hpp"
 
-#include "strata/core/Error.hpp"
-
 #include <chrono>
 #include <cmath>
 #include <set>
 #include <stdexcept>
 
+#include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/vehicles/VehicleStages.hpp"
 

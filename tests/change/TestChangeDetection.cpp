@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "strata/core/Error.hpp"
 #include "strata/change/ChangeDetection.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::change {
 namespace {

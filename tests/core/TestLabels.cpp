@@ -1,9 +1,9 @@
-#include "strata/core/Error.hpp"
-#include "strata/core/Labels.hpp"
-
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+
+#include "strata/core/Error.hpp"
+#include "strata/core/Labels.hpp"
 
 namespace strata::core {
 namespace {

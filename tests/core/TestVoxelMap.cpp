@@ -1,10 +1,9 @@
-#include "strata/core/VoxelMap.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/VoxelMap.hpp"
 
 namespace strata::core {
 namespace {
@@ -95,7 +94,8 @@ TEST(VoxelMap, ExportGridsExpandEndpointsIntoHitsAndPointMeans) {
     EXPECT_NEAR(means->tree().getValue({1, 2, 3}).y(), -0.2, 0.5 / 254);
     // ... and read back as the same map.
     const VoxelMap back = VoxelMap::FromGrids(grids);
-    EXPECT_EQ(back.endpoints->tree().getValue({1, 2, 3}), map.endpoints->tree().getValue({1, 2, 3}));
+    EXPECT_EQ(back.endpoints->tree().getValue({1, 2, 3}),
+              map.endpoints->tree().getValue({1, 2, 3}));
 }
 
 TEST(VoxelMap, MapsWrittenBeforePackedEndpointsReadBack) {
@@ -105,7 +105,8 @@ TEST(VoxelMap, MapsWrittenBeforePackedEndpointsReadBack) {
     hits->setTransform(VoxelMap::MakeTransform(0.5));
     hits->tree().setValueOn({2, 0, 0}, 7);
     // Before point means existed: hits only, means at the voxel centres.
-    const VoxelMap no_means = VoxelMap::FromGrids({map.occupancy, map.label, map.label_weight, hits});
+    const VoxelMap no_means =
+        VoxelMap::FromGrids({map.occupancy, map.label, map.label_weight, hits});
     EXPECT_EQ(no_means.Hits({2, 0, 0}), 7);
     EXPECT_TRUE(no_means.PointMean({2, 0, 0}).isApprox(Eigen::Vector3d(1.25, 0.25, 0.25)));
     // With a Vec3S `point_mean` beside `hits`.

@@ -14,9 +14,8 @@
 #include <limits>
 #include <random>
 
-#include "strata/integration/Integrator.hpp"
-
 #include "strata/core/Error.hpp"
+#include "strata/integration/Integrator.hpp"
 
 namespace strata::integration {
 namespace {

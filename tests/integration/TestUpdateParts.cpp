@@ -1,11 +1,10 @@
-#include "strata/integration/UpdateParts.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "MapDiff.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/integration/UpdateParts.hpp"
 
 namespace strata::integration {
 namespace {

@@ -1,9 +1,8 @@
 #pragma once
 // Shared by the exporter tests: a small labelled map built by hand and a scratch directory.
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <filesystem>

@@ -167,7 +167,8 @@ TEST(VdbExport, VdbPrintListsEveryGrid) {
     // vdb_print exits 0 even when it cannot read a file, so check what it printed.
     const std::string out =
         RunCommand("/usr/bin/vdb_print -l '" + (dir / "map.vdb").string() + "' 2>&1");
-    for (const char* name : {"occupancy", "label", "label_weight", "hits", "point_mean", "density", "color"}) {
+    for (const char* name :
+         {"occupancy", "label", "label_weight", "hits", "point_mean", "density", "color"}) {
         EXPECT_NE(out.find(name), std::string::npos) << name << " missing in:\n" << out;
     }
     EXPECT_NE(out.find("vec3s"), std::string::npos) << out;

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include "RealData.hpp"
 #include "CoarseSearch.hpp"
+#include "RealData.hpp"
 #include "RealPairs.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 

@@ -1,7 +1,5 @@
 // A session integrated by every rank equals the session one process integrates: same fused
 // grids, same layers, same catalog rows (docs/scale.md, "Integrate").
-#include "strata/pipeline/RankedSession.hpp"
-
 #include <gtest/gtest.h>
 
 #include <set>
@@ -9,6 +7,7 @@
 #include "MpiTest.hpp"
 #include "StoreTestUtil.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -26,15 +25,17 @@ fs::path SharedTemp(const std::string& name) {
 
 store::MapStore OpenShared(const fs::path& dir) {
     return OpenOnRanks(dir, TestRanks(), [&] {
-        return store::MapStore::IsMap(dir) ? store::MapStore::Open(dir, store::MapStore::Access::kWrite)
-                                           : store::test::NewMap(dir);
+        return store::MapStore::IsMap(dir)
+                   ? store::MapStore::Open(dir, store::MapStore::Access::kWrite)
+                   : store::test::NewMap(dir);
     });
 }
 
 RankedSessionResult Integrate(store::MapStore& map, const std::vector<core::Scan>& scans,
                               const std::string& name) {
-    return IntegrateOnRanks(map, scans.size(), [&](size_t i) { return scans[i]; }, {},
-                            store::test::Named(name), TestRanks());
+    return IntegrateOnRanks(
+        map, scans.size(), [&](size_t i) { return scans[i]; }, {}, store::test::Named(name),
+        TestRanks());
 }
 
 void ExpectSameLayers(const store::MapStore& a, const store::MapStore& b) {
@@ -111,7 +112,8 @@ TEST(RankedSession, AFailingRankFailsEveryRankAndCommitsNothing) {
         (void)IntegrateOnRanks(
             map, scans.size(),
             [&](size_t i) {
-                if (i == failing) throw FormatError("scan_" + std::to_string(i) + ".pcd: bad header");
+                if (i == failing)
+                    throw FormatError("scan_" + std::to_string(i) + ".pcd: bad header");
                 return scans[i];
             },
             {}, store::test::Named("lost"), ranks);

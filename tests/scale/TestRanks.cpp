@@ -1,5 +1,3 @@
-#include "strata/pipeline/Ranks.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -8,6 +6,7 @@
 
 #include "MpiTest.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/pipeline/Ranks.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -45,7 +44,8 @@ TEST(Ranks, GatherBroadcastAndAgreement) {
     const std::vector<std::string> all = ranks.Gather(std::string(ranks.rank(), 'r'));
     if (ranks.root()) {
         ASSERT_EQ(all.size(), static_cast<size_t>(ranks.size()));
-        for (int r = 0; r < ranks.size(); ++r) EXPECT_EQ(all[static_cast<size_t>(r)].size(), static_cast<size_t>(r));
+        for (int r = 0; r < ranks.size(); ++r)
+            EXPECT_EQ(all[static_cast<size_t>(r)].size(), static_cast<size_t>(r));
     } else {
         EXPECT_TRUE(all.empty());
     }

@@ -1,20 +1,19 @@
 // Commands that read a map tile by tile answer what reading it whole answers (docs/scale.md).
 #include <gtest/gtest.h>
-
-#include <map>
-
-#include "StoreTestUtil.hpp"
-#include "strata/core/Labels.hpp"
-#include "strata/change/MapObserver.hpp"
-#include "strata/core/Error.hpp"
-#include "strata/pipeline/Export.hpp"
-#include "strata/pipeline/Info.hpp"
+#include <openvdb/io/File.h>
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
-#include <openvdb/io/File.h>
 #include <sstream>
+
+#include "StoreTestUtil.hpp"
+#include "strata/change/MapObserver.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/core/Labels.hpp"
+#include "strata/pipeline/Export.hpp"
+#include "strata/pipeline/Info.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -173,11 +172,12 @@ TEST(TileByTile, ChangesReadTileByTileAreTheWholeMapsChanges) {
     ASSERT_GE(whole.objects.size(), 3u);
     size_t tiles_crossed = 0;
     for (const change::ChangeObject& o : whole.objects) {
-        tiles_crossed += std::floor(o.bbox_min.x() / 3.2) != std::floor((o.bbox_max.x() - 1e-6) / 3.2);
+        tiles_crossed +=
+            std::floor(o.bbox_min.x() / 3.2) != std::floor((o.bbox_max.x() - 1e-6) / 3.2);
     }
     EXPECT_GT(tiles_crossed, 0u);
-    ExpectSameChanges(change::DetectChangesByTiles(observer.SessionSide(1),
-                                                   observer.SessionSide(2), map.settings(), query),
+    ExpectSameChanges(change::DetectChangesByTiles(observer.SessionSide(1), observer.SessionSide(2),
+                                                   map.settings(), query),
                       whole);
     // Without growth, in a region, and between snapshots of the fused map.
     query.grow_voxels = 0;
@@ -190,10 +190,10 @@ TEST(TileByTile, ChangesReadTileByTileAreTheWholeMapsChanges) {
     change::ChangeQuery maps;
     const change::ChangeSet whole_maps =
         change::DetectChanges(observer.Map(map.AsOf(1)), observer.Map(map.Latest()), 0.1, maps);
-    ExpectSameChanges(change::DetectChangesByTiles(observer.MapSide(map.AsOf(1)),
-                                                   observer.MapSide(map.Latest()), map.settings(),
-                                                   maps),
-                      whole_maps);
+    ExpectSameChanges(
+        change::DetectChangesByTiles(observer.MapSide(map.AsOf(1)), observer.MapSide(map.Latest()),
+                                     map.settings(), maps),
+        whole_maps);
     // A side already in memory (scans `strata diff` integrated but did not commit), cut per tile.
     ExpectSameChanges(
         change::DetectChangesByTiles(observer.MapSide(map.AsOf(1)),

@@ -131,7 +131,6 @@ TEST(Scene, DemolishedSegmentIsOpenInTheLaterSessionOnly) {
     EXPECT_FALSE(Simulator(after).CastRay(origin, dir, 5.0).has_value());
 }
 
-
 // A scene is the same whatever compiler built strata: the random draws of parked cars and plant
 // crowns happen in one order. The sums below were taken from a gcc build; before the draws were
 // one per statement, a clang build (tools/sanitize.sh asan) placed every car and leaf elsewhere.
@@ -162,4 +161,3 @@ TEST(Scene, SameTrianglesWhateverTheCompiler) {
 }
 
 }  // namespace strata::sim
-

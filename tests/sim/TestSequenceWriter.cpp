@@ -1,12 +1,11 @@
 #include <gtest/gtest.h>
 
-#include "TempPath.hpp"
-#include "strata/io/PoseFiles.hpp"
-
 #include <fstream>
 #include <sstream>
 
 #include "SimTestUtil.hpp"
+#include "TempPath.hpp"
+#include "strata/io/PoseFiles.hpp"
 #include "strata/sim/SequenceWriter.hpp"
 
 namespace strata::sim {

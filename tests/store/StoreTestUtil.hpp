@@ -113,8 +113,8 @@ template <typename E = std::exception>
         if (std::string(e.what()).find(what) != std::string::npos) {
             return ::testing::AssertionSuccess();
         }
-        return ::testing::AssertionFailure() << "message '" << e.what() << "' lacks '" << what
-                                             << "'";
+        return ::testing::AssertionFailure()
+               << "message '" << e.what() << "' lacks '" << what << "'";
     }
     return ::testing::AssertionFailure() << "no exception";
 }

@@ -83,9 +83,15 @@ TEST(History, KeepSinceKeepsTheSnapshotCurrentAtTheDate) {
     EXPECT_EQ(map.HistoryStart(), map.Latest().commit);
     ExpectSameMap(map.LoadMap(map.Latest()), h.at.rbegin()->second);
     EXPECT_TRUE(ThrowsNaming<InvalidArgumentError>(
-        [&] { (void)map.DropHistory({0, "June 1st"}); }, "ISO 8601"));
-    EXPECT_TRUE(ThrowsNaming<InvalidArgumentError>([&] { (void)map.DropHistory({2, "2024-01-01"}); },
-                                                   "exactly one"));
+        [&] {
+            (void)map.DropHistory({0, "June 1st"});
+        },
+        "ISO 8601"));
+    EXPECT_TRUE(ThrowsNaming<InvalidArgumentError>(
+        [&] {
+            (void)map.DropHistory({2, "2024-01-01"});
+        },
+        "exactly one"));
     EXPECT_TRUE(map.Check().ok());
 }
 
@@ -93,8 +99,8 @@ TEST(History, KeepSinceKeepsTheSnapshotCurrentAtTheDate) {
 // snapshot's fused grids and every session's layers voxel-identical, the products and rows kept.
 TEST(History, AFormat4MapIsMigratedWithEverySnapshotAndLayerIdentical) {
     const History h = MakeHistory("migrate");
-    ProductCommit walls{"walls", {}, nullptr,
-                        {R"({"wall_id": 1, "center_x": 1, "center_y": 2, "center_z": 3,
+    ProductCommit walls{
+        "walls", {}, nullptr, {R"({"wall_id": 1, "center_x": 1, "center_y": 2, "center_z": 3,
                             "normal_x": 1, "normal_y": 0, "normal_z": 0, "slant_deg": 88.5,
                             "uncertainty_deg": 0.2, "lean_azimuth_deg": 90, "area_m2": 12,
                             "rms_m": 0.01, "length_m": 4, "height_m": 3, "inliers": 500})"}};
@@ -132,7 +138,9 @@ TEST(History, AFormat4MapIsMigratedWithEverySnapshotAndLayerIdentical) {
         for (size_t i = 0; i < files.size(); ++i) {
             const SessionLayer l = map.ReadLayer(files[i]);
             EXPECT_EQ(files[i].key, expected[i].first);
-            EXPECT_EQ(testing::FirstDifference("occupied", *l.occupied, *expected[i].second.occupied), "");
+            EXPECT_EQ(
+                testing::FirstDifference("occupied", *l.occupied, *expected[i].second.occupied),
+                "");
             EXPECT_EQ(testing::FirstDifference("free", *l.free, *expected[i].second.free), "");
         }
     }

@@ -41,11 +41,11 @@ size_t ProductVoxels(const MapStore& map, const std::string& kind, const std::st
 std::vector<std::string> Sql(const fs::path& map, const std::string& sql) {
     sqlite3* db = nullptr;
     std::vector<std::string> rows;
-    EXPECT_EQ(sqlite3_open_v2((map / "catalog.sqlite").c_str(), &db, SQLITE_OPEN_READONLY,
-                              nullptr),
+    EXPECT_EQ(sqlite3_open_v2((map / "catalog.sqlite").c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
               SQLITE_OK);
     sqlite3_stmt* q = nullptr;
-    EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &q, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+    EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &q, nullptr), SQLITE_OK)
+        << sqlite3_errmsg(db);
     while (q && sqlite3_step(q) == SQLITE_ROW) {
         std::string row;
         for (int c = 0; c < sqlite3_column_count(q); ++c) {
@@ -144,8 +144,8 @@ TEST(Products, BadKindsRowsAndGridsAreRefusedBeforeAnythingIsWritten) {
     const fs::path tile_dir = (dir / before.tiles.back().file).parent_path();
     fs::permissions(tile_dir, fs::perms::owner_write, fs::perm_options::remove);
     if (::access(tile_dir.c_str(), W_OK) != 0) {  // root ignores permissions
-        EXPECT_THROW((void)map.CommitProduct({"marks", {ProductOver(map.LoadMap(before), 1.0f)},
-                                              nullptr, {"{}"}}),
+        EXPECT_THROW((void)map.CommitProduct(
+                         {"marks", {ProductOver(map.LoadMap(before), 1.0f)}, nullptr, {"{}"}}),
                      IoError);
     }
     fs::permissions(tile_dir, fs::perms::owner_write, fs::perm_options::add);

@@ -89,8 +89,8 @@ TEST(SessionWorkers, AWorkerNeedsACommitterAndCannotCommit) {
     MapStore read = MapStore::Open(dir, MapStore::Access::kRead);
     SessionOptions options;
     options.worker_of_session = 1;
-    EXPECT_TRUE(ThrowsNaming<InvalidArgumentError>(
-        [&] { SessionWriter w(read, {}, options); }, "writer lock"));
+    EXPECT_TRUE(ThrowsNaming<InvalidArgumentError>([&] { SessionWriter w(read, {}, options); },
+                                                   "writer lock"));
     MapStore map = MapStore::Open(dir, MapStore::Access::kWrite);
     SessionWriter worker(read, {}, options);
     (void)worker.Integrate(RoomScan(3, {0, 0, 0}));

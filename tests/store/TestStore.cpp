@@ -33,10 +33,9 @@ TEST(Store, CreateRecordsSettingsAndRefusesToOverwrite) {
     EXPECT_EQ(map.settings().integration.max_range_m, IntegrationConfig{}.max_range_m);
     EXPECT_TRUE(ThrowsNaming<InvalidArgumentError>([&] { (void)MapStore::Create(dir, settings); },
                                                    dir.string()));
-    EXPECT_TRUE(
-        ThrowsNaming<NotFoundError>(
-            [&] { (void)MapStore::Open(Temp("nothing"), MapStore::Access::kRead); },
-            "no such map directory"));
+    EXPECT_TRUE(ThrowsNaming<NotFoundError>(
+        [&] { (void)MapStore::Open(Temp("nothing"), MapStore::Access::kRead); },
+        "no such map directory"));
     const fs::path empty = Temp("empty");
     fs::create_directories(empty);
     EXPECT_TRUE(ThrowsNaming([&] { (void)MapStore::Open(empty, MapStore::Access::kRead); },
@@ -157,8 +156,8 @@ TEST(Store, SessionLayersSayWhatEachSessionSaw) {
     size_t occupied = 0;
     for (const LayerFile& file : latest.layers) {
         EXPECT_EQ(file.file, "tiles/" + std::to_string(file.key.x) + "_" +
-                                 std::to_string(file.key.y) + "/s" +
-                                 std::to_string(file.session) + ".vdb");
+                                 std::to_string(file.key.y) + "/s" + std::to_string(file.session) +
+                                 ".vdb");
         const SessionLayer layer = map.ReadLayer(file);
         const auto version = std::find_if(latest.tiles.begin(), latest.tiles.end(),
                                           [&](const TileVersion& v) { return v.key == file.key; });
@@ -382,7 +381,8 @@ TEST(Store, DamagedTilesAreNamedAndOthersStillRead) {
         f.put('\x5a' ^ static_cast<char>(f.peek()));
     }
     fs::resize_file(cut, 8);  // OpenVDB would read a bare header as a valid, empty file
-    EXPECT_TRUE(ThrowsNaming<FormatError>([&] { (void)map.ReadFused(tiles[0]); }, flipped.string()));
+    EXPECT_TRUE(
+        ThrowsNaming<FormatError>([&] { (void)map.ReadFused(tiles[0]); }, flipped.string()));
     EXPECT_TRUE(ThrowsNaming<FormatError>([&] { (void)map.ReadFused(tiles[0]); }, "checksum"));
     EXPECT_TRUE(ThrowsNaming<FormatError>([&] { (void)map.ReadFused(tiles[1]); }, "bytes"));
     EXPECT_NO_THROW((void)map.ReadFused(tiles[2]));

@@ -114,8 +114,9 @@ TEST(TileReader, ConcurrentReadsSeeTheSameGrids) {
     std::vector<size_t> voxels(keys.size() * 8);
     tbb::parallel_for(size_t{0}, voxels.size(), [&](size_t i) {
         const TileKey& key = keys[i % keys.size()];
-        voxels[i] = reader.Fused(key)->occupancy->activeVoxelCount() +
-                    (reader.Layers(key, 1) ? reader.Layers(key, 1)->occupied->activeVoxelCount() : 0);
+        voxels[i] =
+            reader.Fused(key)->occupancy->activeVoxelCount() +
+            (reader.Layers(key, 1) ? reader.Layers(key, 1)->occupied->activeVoxelCount() : 0);
     });
     for (size_t i = keys.size(); i < voxels.size(); ++i) {
         EXPECT_EQ(voxels[i], voxels[i % keys.size()]);

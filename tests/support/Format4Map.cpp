@@ -1,12 +1,12 @@
 #include "Format4Map.hpp"
 
+#include <openvdb/io/Stream.h>
 #include <sqlite3.h>
 #include <xxhash.h>
 
 #include <cstdio>
 #include <fstream>
 #include <map>
-#include <openvdb/io/Stream.h>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -80,7 +80,8 @@ std::pair<uint64_t, uint64_t> WriteTile(const fs::path& path, const openvdb::Gri
     stream.setCompression(openvdb::io::COMPRESS_ACTIVE_MASK);
     stream.write(grids, meta);
     const std::string bytes = os.str();
-    std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(path, std::ios::binary)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     return {bytes.size(), XXH64(bytes.data(), bytes.size(), 0)};
 }
 
@@ -200,8 +201,10 @@ void RewriteAsFormat4(const fs::path& map) {
     Catalog db(map / "catalog.sqlite");
     std::string sql = "BEGIN;\nDELETE FROM tile_versions;\n";
     for (const std::string& values : inserts) {
-        sql += "INSERT INTO tile_versions(x, y, version, file, byte_size, checksum, commit_id) "
-               "VALUES (" + values + ");\n";
+        sql +=
+            "INSERT INTO tile_versions(x, y, version, file, byte_size, checksum, commit_id) "
+            "VALUES (" +
+            values + ");\n";
     }
     // The views go first: format 4 has tables of the same names.
     for (const auto& v : db.Rows("SELECT name FROM sqlite_master WHERE type = 'view'")) {
@@ -209,15 +212,16 @@ void RewriteAsFormat4(const fs::path& map) {
     }
     std::string wall_columns;
     for (const char* c : {"wall_id", "center_x", "center_y", "center_z", "normal_x", "normal_y",
-                          "normal_z", "slant_deg", "uncertainty_deg", "lean_azimuth_deg",
-                          "area_m2", "rms_m", "length_m", "height_m", "inliers"}) {
+                          "normal_z", "slant_deg", "uncertainty_deg", "lean_azimuth_deg", "area_m2",
+                          "rms_m", "length_m", "height_m", "inliers"}) {
         wall_columns += std::string(", json_extract(row, '$.") + c + "')";
     }
     sql += kFormat4Tables;
-    sql += "INSERT INTO walls(commit_id, wall_id, center_x, center_y, center_z, normal_x, "
-           "normal_y, normal_z, slant_deg, uncertainty_deg, lean_azimuth_deg, area_m2, rms_m, "
-           "length_m, height_m, inliers) SELECT commit_id" + wall_columns +
-           " FROM product_rows WHERE kind = 'walls' ORDER BY id;\n";
+    sql +=
+        "INSERT INTO walls(commit_id, wall_id, center_x, center_y, center_z, normal_x, "
+        "normal_y, normal_z, slant_deg, uncertainty_deg, lean_azimuth_deg, area_m2, rms_m, "
+        "length_m, height_m, inliers) SELECT commit_id" +
+        wall_columns + " FROM product_rows WHERE kind = 'walls' ORDER BY id;\n";
     sql += R"sql(
 INSERT INTO vehicles(commit_id, vehicle_id, center_x, center_y, center_z, length_m, width_m,
   height_m, yaw_deg, source, voxels, cleared_voxels, refilled_cells, refused_cells)
@@ -241,10 +245,12 @@ INSERT INTO change_sets(id, commit_id, created_utc, from_side, to_side, added_vo
     for (int i = 0; i < 16; ++i) {
         matrix += " || ' ' || json_extract(row, '$.T_map_floor[" + std::to_string(i) + "]')";
     }
-    sql += "INSERT INTO settings(key, value) SELECT 'floor.' || json_extract(row, '$.floor'), "
-           "json_extract(row, '$.session') || ' ' || json_extract(row, '$.z_m')" + matrix +
-           " FROM product_rows WHERE kind = 'floors' AND commit_id = "
-           "(SELECT MAX(id) FROM commits WHERE kind = 'floors');\n";
+    sql +=
+        "INSERT INTO settings(key, value) SELECT 'floor.' || json_extract(row, '$.floor'), "
+        "json_extract(row, '$.session') || ' ' || json_extract(row, '$.z_m')" +
+        matrix +
+        " FROM product_rows WHERE kind = 'floors' AND commit_id = "
+        "(SELECT MAX(id) FROM commits WHERE kind = 'floors');\n";
     sql += R"sql(
 DROP TABLE product_rows;
 DROP TABLE products;

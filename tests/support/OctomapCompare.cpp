@@ -40,9 +40,8 @@ std::vector<KeyValue> OctomapValues(const octomap::OcTree& tree) {
         for (int32_t dx = 0; dx < n; ++dx) {
             for (int32_t dy = 0; dy < n; ++dy) {
                 for (int32_t dz = 0; dz < n; ++dz) {
-                    out.emplace_back(PackKey(k[0] - kOffset + dx, k[1] - kOffset + dy,
-                                             k[2] - kOffset + dz),
-                                     v);
+                    out.emplace_back(
+                        PackKey(k[0] - kOffset + dx, k[1] - kOffset + dy, k[2] - kOffset + dz), v);
                 }
             }
         }

@@ -14,11 +14,11 @@ namespace strata::testing {
 
 /// What differs between the two maps. A voxel is compared when either side observed it.
 struct MapDifferences {
-    size_t voxels_ours = 0;     ///< observed voxels in the strata map
-    size_t voxels_theirs = 0;   ///< observed voxels in the OctoMap tree, pruned nodes expanded
-    size_t only_ours = 0;       ///< observed by strata, unknown to OctoMap
-    size_t only_theirs = 0;     ///< observed by OctoMap, unknown to strata
-    size_t state_differs = 0;   ///< observed by both, occupied on one side and free on the other
+    size_t voxels_ours = 0;       ///< observed voxels in the strata map
+    size_t voxels_theirs = 0;     ///< observed voxels in the OctoMap tree, pruned nodes expanded
+    size_t only_ours = 0;         ///< observed by strata, unknown to OctoMap
+    size_t only_theirs = 0;       ///< observed by OctoMap, unknown to strata
+    size_t state_differs = 0;     ///< observed by both, occupied on one side and free on the other
     size_t log_odds_differs = 0;  ///< observed by both, |difference| above the tolerance
     double max_log_odds_difference = 0.0;  ///< over the voxels observed by both
     std::vector<std::string> examples;     ///< the first few differences, for a failure message

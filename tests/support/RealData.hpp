@@ -20,15 +20,15 @@ namespace strata::test {
 }  // namespace strata::test
 
 /// Skips the calling test when `data_path` does not exist, or fails it under STRATA_REQUIRE_DATA=1.
-#define STRATA_SKIP_WITHOUT_DATA(data_path)                                                          \
-    do {                                                                                        \
-        const std::filesystem::path strata_data_path_(data_path);                                    \
-        if (!std::filesystem::exists(strata_data_path_)) {                                      \
-            if (::strata::test::RealDataRequired()) {                                           \
-                FAIL() << "real data not found: " << strata_data_path_                          \
-                       << " (STRATA_REQUIRE_DATA=1; see ../shared/data/README.md)";             \
-            }                                                                                   \
-            GTEST_SKIP() << "real data not found: " << strata_data_path_                        \
-                         << " (see ../shared/data/README.md)";                                  \
-        }                                                                                       \
+#define STRATA_SKIP_WITHOUT_DATA(data_path)                                         \
+    do {                                                                            \
+        const std::filesystem::path strata_data_path_(data_path);                   \
+        if (!std::filesystem::exists(strata_data_path_)) {                          \
+            if (::strata::test::RealDataRequired()) {                               \
+                FAIL() << "real data not found: " << strata_data_path_              \
+                       << " (STRATA_REQUIRE_DATA=1; see ../shared/data/README.md)"; \
+            }                                                                       \
+            GTEST_SKIP() << "real data not found: " << strata_data_path_            \
+                         << " (see ../shared/data/README.md)";                      \
+        }                                                                           \
     } while (false)

@@ -34,8 +34,8 @@ VoxelSets OctomapVoxelSets(const octomap::OcTree& tree) {
         for (int32_t dx = 0; dx < n; ++dx) {
             for (int32_t dy = 0; dy < n; ++dy) {
                 for (int32_t dz = 0; dz < n; ++dz) {
-                    out.push_back(PackKey(k[0] - offset + dx, k[1] - offset + dy,
-                                          k[2] - offset + dz));
+                    out.push_back(
+                        PackKey(k[0] - offset + dx, k[1] - offset + dy, k[2] - offset + dz));
                 }
             }
         }

@@ -39,8 +39,8 @@ inline SequenceSpec FaultSequence() {
 
 // Session `session` (1-based) integrates frame (session - 1) mod 4 of `seq`: the same session
 // number always gets the same input, in any map.
-inline std::vector<std::string> IntegrateArgs(const fs::path& map, const fs::path& seq,
-                                              int session, double tile_m = kTileM) {
+inline std::vector<std::string> IntegrateArgs(const fs::path& map, const fs::path& seq, int session,
+                                              double tile_m = kTileM) {
     return {"integrate",   map.string(),
             "--kitti",     seq.string(),
             "--frames",    std::to_string((session - 1) % kSequenceScans),
@@ -77,7 +77,7 @@ inline core::VoxelMap LoadLatest(const fs::path& map) {
 
 // Exact equality of two maps, voxel by voxel: occupancy, label, label weight and hits.
 inline ::testing::AssertionResult SameMap(const core::VoxelMap& actual,
-                                           const core::VoxelMap& expected) {
+                                          const core::VoxelMap& expected) {
     const std::string diff = strata::testing::MapDifference(actual, expected);
     if (!diff.empty()) return ::testing::AssertionFailure() << diff;
     return ::testing::AssertionSuccess();

@@ -16,18 +16,20 @@ namespace {
 namespace fs = std::filesystem;
 
 using strata::store::MapStore;
-using strata::tools::test::MakeSequence;
 using strata::tools::test::FailedWith;
 using strata::tools::test::kBadFormat;
 using strata::tools::test::kNotFound;
 using strata::tools::test::kRefused;
 using strata::tools::test::kUsage;
+using strata::tools::test::MakeSequence;
 using strata::tools::test::MapFiles;
 using strata::tools::test::Result;
 using strata::tools::test::Strata;
 using strata::tools::test::Temp;
 
-MapStore OpenForReading(const fs::path& map) { return MapStore::Open(map, MapStore::Access::kRead); }
+MapStore OpenForReading(const fs::path& map) {
+    return MapStore::Open(map, MapStore::Access::kRead);
+}
 
 TEST(Cli, IntegrateInfoAndExportEndToEnd) {
     const fs::path seq = MakeSequence(Temp("seq"));
@@ -62,7 +64,9 @@ TEST(Cli, BadArgumentsAndInputsFailWithAMessage) {
     // nothing written.
     const fs::path map = Temp("bad_export");
     ASSERT_EQ(Strata("integrate " + map.string() + " --kitti " +
-                     MakeSequence(Temp("bad_export_seq")).string()).code, 0);
+                     MakeSequence(Temp("bad_export_seq")).string())
+                  .code,
+              0);
     const fs::path out = Temp("export.xyz");
     EXPECT_TRUE(FailedWith(Strata("export " + map.string() + " --out " + out.string()), kUsage,
                            "unknown export format 'xyz'"));
@@ -119,9 +123,9 @@ TEST(Cli, IntegratesTextScansWithAPoseFile) {
     }
     strata::io::WriteKittiPoses(dir / "poses.txt", poses);
     const fs::path map = Temp("textmap");
-    const Result r = Strata("integrate " + map.string() + " --scans " + (dir / "scan0.txt").string() +
-                            " " + (dir / "scan1.txt").string() + " --poses " +
-                            (dir / "poses.txt").string() + " --voxel 0.1");
+    const Result r = Strata("integrate " + map.string() + " --scans " +
+                            (dir / "scan0.txt").string() + " " + (dir / "scan1.txt").string() +
+                            " --poses " + (dir / "poses.txt").string() + " --voxel 0.1");
     ASSERT_EQ(r.code, 0) << r.out;
     const MapStore store = OpenForReading(map);
     ASSERT_EQ(store.Latest().sessions.at(0).scans, 2u);
@@ -136,8 +140,8 @@ TEST(Cli, IntegratesAGeoreferencedLasTileAsPointsOnly) {
     const fs::path las = fs::path(STRATA_DATA_DIR) / "autzen_las" / "autzen_trim.las";
     STRATA_SKIP_WITHOUT_DATA(las);
     const fs::path map = Temp("las");
-    const Result r =
-        Strata("integrate " + map.string() + " --scans " + las.string() + " --points-only --voxel 2");
+    const Result r = Strata("integrate " + map.string() + " --scans " + las.string() +
+                            " --points-only --voxel 2");
     ASSERT_EQ(r.code, 0) << r.out;
     const Result info = Strata("info " + map.string() + " --json");
     const auto j = nlohmann::json::parse(info.out.substr(info.out.find('{')));
@@ -189,8 +193,8 @@ TEST(Cli, IntegratesRawBinScansAndRefusesAmbiguousOnesWithoutChangingTheMap) {
     const auto before = MapFiles(map);
     // 5 points = 80 bytes: 5 KITTI points or 4 nuScenes points. Refused, naming the file.
     strata::io::WriteKittiBin(dir / "000001.bin", {wall.begin(), wall.begin() + 5}, {});
-    const Result ambiguous = Strata("integrate " + map.string() + " --scans " +
-                                    (dir / "000001.bin").string());
+    const Result ambiguous =
+        Strata("integrate " + map.string() + " --scans " + (dir / "000001.bin").string());
     EXPECT_TRUE(FailedWith(ambiguous, kBadFormat, "000001.bin"));
     EXPECT_NE(ambiguous.out.find("--bin-fields"), std::string::npos) << ambiguous.out;
     EXPECT_EQ(MapFiles(map), before);

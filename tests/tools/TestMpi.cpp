@@ -20,8 +20,8 @@ namespace {
 const char* const kMpirun = "mpirun --allow-run-as-root --oversubscribe";
 
 Result Mpirun(int ranks, const std::string& args) {
-    return Shell(std::string(kMpirun) + " -n " + std::to_string(ranks) + " " + STRATA_BINARY +
-                 " " + args);
+    return Shell(std::string(kMpirun) + " -n " + std::to_string(ranks) + " " + STRATA_BINARY + " " +
+                 args);
 }
 
 size_t Count(const std::string& text, const std::string& what) {
@@ -115,7 +115,8 @@ TEST(MpiCli, AKilledRankFailsTheCommandAndLeavesTheLastCommit) {
     const bool killed = ::kill(victim, SIGKILL) == 0;
     run.join();
     const std::string log = ReadText(log_file);
-    std::printf("[ mpi ] rank 1 (pid %d) %s:\n%s\n", victim, killed ? "killed" : "had ended", log.c_str());
+    std::printf("[ mpi ] rank 1 (pid %d) %s:\n%s\n", victim, killed ? "killed" : "had ended",
+                log.c_str());
     ASSERT_TRUE(killed) << "rank 1 finished before it could be killed; make the sequence longer";
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << "mpirun status " << status;
     EXPECT_NE(log.find("rank 1"), std::string::npos) << log;  // mpirun names the rank

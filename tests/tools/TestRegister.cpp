@@ -7,8 +7,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "RealData.hpp"
 #include "CliTestUtil.hpp"
+#include "RealData.hpp"
 #include "RealPairs.hpp"
 #include "strata/store/MapStore.hpp"
 
@@ -109,7 +109,7 @@ TEST(RegistrationCli, FindsASessionRecordedInAMovedFrameWithTheFixedKeys) {
 // guess 0.5 m / 3 deg off the raw-point optimum (tests/support/RawIcp.hpp), which the library
 // test measures in detail (RegistrationRealData.*).
 TEST(RegistrationCli, RegistersAKitti00ScanOnTheRawPointOptimum) {
-    using namespace registration::test;                 // NOLINT: the real-data references
+    using namespace registration::test;                  // NOLINT: the real-data references
     constexpr double kVsRawDeg = 0.03, kVsRawM = 0.005;  // measured 0.012 deg, 1.9 mm
     const fs::path dir = fs::path(STRATA_DATA_DIR) / "kitti00";
     STRATA_SKIP_WITHOUT_DATA(dir / "poses_sptam.txt");

@@ -24,8 +24,8 @@
 
 #include "CliTestUtil.hpp"
 #include "Format4Map.hpp"
-#include "StoreFaultUtil.hpp"
 #include "MapDiff.hpp"
+#include "StoreFaultUtil.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/store/MapStore.hpp"
 
@@ -35,30 +35,30 @@ namespace fs = std::filesystem;
 using strata::core::VoxelMap;
 using strata::store::MapStore;
 using strata::tools::test::Child;
-using strata::tools::test::KillAt;
-using strata::tools::test::MakeSequence;
-using strata::tools::test::MapFiles;
-using strata::tools::test::Outcome;
-using strata::tools::test::ReadText;
-using strata::tools::test::Result;
-using strata::tools::test::SequenceSpec;
-using strata::tools::test::Spawn;
-using strata::tools::test::Strata;
-using strata::tools::test::Temp;
-using strata::tools::test::Wait;
 using strata::tools::test::FaultSequence;
 using strata::tools::test::IntegrateArgs;
 using strata::tools::test::Join;
 using strata::tools::test::JsonIn;
+using strata::tools::test::KillAt;
 using strata::tools::test::KillAttempts;
-using strata::tools::test::LoadLatest;
-using strata::tools::test::OpenForReading;
-using strata::tools::test::SameMap;
-using strata::tools::test::Seed;
-using strata::tools::test::SessionCount;
 using strata::tools::test::kSequenceScans;
 using strata::tools::test::kTileM;
 using strata::tools::test::kVoxelM;
+using strata::tools::test::LoadLatest;
+using strata::tools::test::MakeSequence;
+using strata::tools::test::MapFiles;
+using strata::tools::test::OpenForReading;
+using strata::tools::test::Outcome;
+using strata::tools::test::ReadText;
+using strata::tools::test::Result;
+using strata::tools::test::SameMap;
+using strata::tools::test::Seed;
+using strata::tools::test::SequenceSpec;
+using strata::tools::test::SessionCount;
+using strata::tools::test::Spawn;
+using strata::tools::test::Strata;
+using strata::tools::test::Temp;
+using strata::tools::test::Wait;
 using Clock = std::chrono::steady_clock;
 
 constexpr double kOneTileM = 64.0;  // with --origin 32,32,0 the whole room is in one tile
@@ -485,11 +485,12 @@ TEST(StoreFaults, WriteErrorsFailTheCommitAndLeaveTheMap) {
         {"catalog.sqlite-wal", "ENOSPC", "catalog.sqlite: database or disk is full"}};
     for (const Case& c : cases) {
         const std::string what = c.error + " on " + c.on;
-        const Result r = StrataWithEio(c.on, Join(IntegrateArgs(f.map, f.seq, 2)), "write", c.error);
+        const Result r =
+            StrataWithEio(c.on, Join(IntegrateArgs(f.map, f.seq, 2)), "write", c.error);
         EXPECT_NE(r.code, 0) << what << ": " << r.out;
         EXPECT_NE(r.out.find(c.named), std::string::npos) << what << ": " << r.out;
-        const std::string file = c.on == "/tiles/" ? (f.map / "tiles").string()
-                                                   : (f.map / "catalog.sqlite").string();
+        const std::string file =
+            c.on == "/tiles/" ? (f.map / "tiles").string() : (f.map / "catalog.sqlite").string();
         EXPECT_NE(r.out.find(file), std::string::npos) << what << ": " << r.out;
         EXPECT_EQ(SessionCount(f.map), 1u) << what;
         EXPECT_TRUE(SameMap(LoadLatest(f.map), map_before)) << what;
@@ -669,8 +670,8 @@ TEST(StoreFaults, IntegrateRefusesFlagsThatContradictTheMapsRule) {
         EXPECT_NE(r.out.find(named), std::string::npos) << r.out;
         EXPECT_NE(r.out.find(f.map.string()), std::string::npos) << r.out;
     }
-    EXPECT_NE(Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " --max-range 40").out.find(
-                  "built with --max-range 30"),
+    EXPECT_NE(Strata(Join(IntegrateArgs(f.map, f.seq, 2)) + " --max-range 40")
+                  .out.find("built with --max-range 30"),
               std::string::npos);
     EXPECT_EQ(MapFiles(f.map), files_before);
     EXPECT_EQ(SessionCount(f.map), 1u);

@@ -20,7 +20,7 @@ namespace strata::tools::test {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr int kSessions = 10;  // the migration target: a 10-session format-4 map
+constexpr int kSessions = 10;        // the migration target: a 10-session format-4 map
 constexpr double kKillSpread = 1.3;  // kill times spread over 1.3x the measured run
 
 // A format-5 map of kSessions sessions, its fused map after each session, and the same map
@@ -80,11 +80,12 @@ void KillAtRandom(const fs::path& from, const std::vector<std::string>& args_bef
         const fs::path map = CopyOf(from, "kills_attempt");
         const double delay_s = when(rng);
         const Child child = Spawn(args(map), log);
-        const Outcome out = KillAt(child, child.start + std::chrono::duration_cast<Clock::duration>(
-                                                            std::chrono::duration<double>(delay_s)));
+        const Outcome out =
+            KillAt(child, child.start + std::chrono::duration_cast<Clock::duration>(
+                                            std::chrono::duration<double>(delay_s)));
         SCOPED_TRACE("attempt " + std::to_string(attempt) + ": kill at " + std::to_string(delay_s) +
-                     " s of " + std::to_string(full.seconds) + " s: " +
-                     (out.killed ? "killed" : "exited " + std::to_string(out.code)));
+                     " s of " + std::to_string(full.seconds) +
+                     " s: " + (out.killed ? "killed" : "exited " + std::to_string(out.code)));
         if (!out.killed) {
             ASSERT_EQ(out.code, 0) << ReadText(log);
         }
@@ -126,7 +127,8 @@ TEST(StoreFaults, KilledUpgradesLeaveTheOldFormatOrTheNew) {
         ASSERT_EQ(check.code, 0) << check.out;
         const store::MapStore store = OpenForReading(map);
         for (int s = 1; s <= kSessions; s += 3) {
-            ASSERT_TRUE(SameMap(store.LoadMap(store.AsOf(s)), maps.after[s - 1])) << "session " << s;
+            ASSERT_TRUE(SameMap(store.LoadMap(store.AsOf(s)), maps.after[s - 1]))
+                << "session " << s;
         }
         ASSERT_TRUE(SameMap(store.LoadMap(store.Latest()), maps.after.back()));
         ASSERT_EQ(store.SessionLayers(kSessions).size(),
@@ -143,26 +145,29 @@ TEST(StoreFaults, KilledHistoryDropsLeaveTheHistoryBeforeOrAfter) {
     const Maps& maps = TenSessions();
     const int64_t latest = OpenForReading(maps.current).Latest().commit;
     int before = 0, after = 0;
-    KillAtRandom(maps.current, {"gc"}, {"--keep-last", "3"}, [&](const fs::path& map, const Outcome&) {
-        const Result check = Strata("check " + map.string() + " --json");
-        ASSERT_EQ(check.code, 0) << check.out;
-        const store::MapStore store = OpenForReading(map);
-        ASSERT_TRUE(SameMap(store.LoadMap(store.Latest()), maps.after.back()));
-        const int64_t start = store.HistoryStart();
-        ASSERT_TRUE(start == 1 || start == latest - 2) << start;
-        if (start == 1) {
-            ++before;
-            ASSERT_TRUE(SameMap(store.LoadMap(store.AsOf(1)), maps.after[0]));
-        } else {
-            ++after;
-            ASSERT_THROW((void)store.AsOf(1), strata::NotFoundError);
-            ASSERT_TRUE(SameMap(store.LoadMap(store.AsOf(kSessions - 2)), maps.after[kSessions - 3]));
-        }
-        // Whatever a kill left over, the next gc removes, and the map stays the same.
-        const Result gc = Strata("gc " + map.string());
-        ASSERT_EQ(gc.code, 0) << gc.out;
-        ASSERT_TRUE(JsonIn(Strata("check " + map.string() + " --json").out)["unreferenced"].empty());
-    });
+    KillAtRandom(
+        maps.current, {"gc"}, {"--keep-last", "3"}, [&](const fs::path& map, const Outcome&) {
+            const Result check = Strata("check " + map.string() + " --json");
+            ASSERT_EQ(check.code, 0) << check.out;
+            const store::MapStore store = OpenForReading(map);
+            ASSERT_TRUE(SameMap(store.LoadMap(store.Latest()), maps.after.back()));
+            const int64_t start = store.HistoryStart();
+            ASSERT_TRUE(start == 1 || start == latest - 2) << start;
+            if (start == 1) {
+                ++before;
+                ASSERT_TRUE(SameMap(store.LoadMap(store.AsOf(1)), maps.after[0]));
+            } else {
+                ++after;
+                ASSERT_THROW((void)store.AsOf(1), strata::NotFoundError);
+                ASSERT_TRUE(
+                    SameMap(store.LoadMap(store.AsOf(kSessions - 2)), maps.after[kSessions - 3]));
+            }
+            // Whatever a kill left over, the next gc removes, and the map stays the same.
+            const Result gc = Strata("gc " + map.string());
+            ASSERT_EQ(gc.code, 0) << gc.out;
+            ASSERT_TRUE(
+                JsonIn(Strata("check " + map.string() + " --json").out)["unreferenced"].empty());
+        });
     std::printf("gc kills: history whole %d times, dropped %d times\n", before, after);
     EXPECT_GE(before, 1);
     EXPECT_GE(after, 1);

@@ -91,11 +91,13 @@ TEST(VehiclesCli, StoresTheCleanedMapAsOneCommitThatAsOfCanUndo) {
 TEST(VehiclesCli, BadArgumentsAndFailedOutputsLeaveTheMapAsItWas) {
     const fs::path map = CopyOfGarage("vehicles_bad");
     const auto before = MapFiles(map);
-    EXPECT_TRUE(FailedWith(Strata("vehicles " + map.string() + " --source paint"), kUsage, "paint"));
+    EXPECT_TRUE(
+        FailedWith(Strata("vehicles " + map.string() + " --source paint"), kUsage, "paint"));
     EXPECT_TRUE(FailedWith(Strata("vehicles " + map.string() + " --png /nonexistent/dir/v.png"),
                            kFailed, "/nonexistent/dir/v.png"));
     EXPECT_EQ(MapFiles(map), before);
-    EXPECT_TRUE(FailedWith(Strata("vehicles " + Temp("no_such_map").string()), kNotFound, "no map"));
+    EXPECT_TRUE(
+        FailedWith(Strata("vehicles " + Temp("no_such_map").string()), kNotFound, "no map"));
 }
 
 }  // namespace

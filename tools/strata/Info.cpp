@@ -1,4 +1,6 @@
 // strata info: what a map holds (voxel size, observed voxels, classes, extents, sizes, sessions).
+#include "strata/pipeline/Info.hpp"
+
 #include <cstdint>
 #include <iostream>
 #include <memory>
@@ -6,7 +8,6 @@
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
-#include "strata/pipeline/Info.hpp"
 
 namespace strata::tools {
 
@@ -28,8 +29,7 @@ void PrintText(const nlohmann::json& j) {
     const auto mb = [&](const char* key) { return b[key].get<uint64_t>() / 1e6; };
     std::cout << "tiles        " << j["tiles"] << " of " << j["tile_size_m"] << " m ("
               << mb("fused_current") << " MB), " << j["tile_versions"]
-              << " fused versions kept (history from commit " << j["history_start_commit"]
-              << ")\n"
+              << " fused versions kept (history from commit " << j["history_start_commit"] << ")\n"
               << "files        " << mb("fused_older") << " MB older fused, " << mb("layers")
               << " MB session layers, " << mb("products") << " MB products, " << mb("catalog")
               << " MB catalog\n"
@@ -54,11 +54,13 @@ void RegisterInfo(CLI::App& app) {
     auto as_of = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand("info", "Show what a map holds");
-    cmd->footer("Examples:\n  strata info city.strata --json | jq .classes\n"
-                "  strata info city.strata --as-of 2");
+    cmd->footer(
+        "Examples:\n  strata info city.strata --json | jq .classes\n"
+        "  strata info city.strata --as-of 2");
     cmd->add_option("MAP", *map, "Map directory")->required();
     cmd->add_flag("--json", *json, "Print JSON");
-    cmd->add_option("--as-of", *as_of, "Show the map as it was right after this session (id or name)");
+    cmd->add_option("--as-of", *as_of,
+                    "Show the map as it was right after this session (id or name)");
     cmd->callback([map, as_of, json] {
         const auto j = pipeline::DescribeMap(OpenMap(*map), *as_of);
         if (*json) {

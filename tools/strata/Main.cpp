@@ -103,7 +103,8 @@ const strata::pipeline::Ranks& strata::tools::CommandRanks() { return *g_ranks; 
 int main(int argc, char** argv) {
     try {
         // MPI (under mpirun) is finalised when `ranks` goes, after the command.
-        const strata::pipeline::Ranks ranks = strata::pipeline::Ranks::FromEnvironment(&argc, &argv);
+        const strata::pipeline::Ranks ranks =
+            strata::pipeline::Ranks::FromEnvironment(&argc, &argv);
         return RunCommand(argc, argv, ranks);
     } catch (const std::exception& e) {
         std::cerr << "strata: error: " << e.what() << "\n";

@@ -25,13 +25,13 @@ void Check(const std::string& dir, bool json) {
         j["unreferenced"] = report.unreferenced;
         std::cout << j.dump(2) << "\n";
     } else {
-        std::cout << dir << ": " << report.files << " files checked, "
-                  << report.problems.size() << " problems\n";
+        std::cout << dir << ": " << report.files << " files checked, " << report.problems.size()
+                  << " problems\n";
         for (const auto& p : report.problems) std::cout << "  " << p.file << ": " << p.what << "\n";
         if (!report.unreferenced.empty()) {
             std::cout << report.unreferenced.size()
-                      << " unreferenced files (left by an interrupted command; `strata gc "
-                      << dir << "` removes them)\n";
+                      << " unreferenced files (left by an interrupted command; `strata gc " << dir
+                      << "` removes them)\n";
         }
     }
     if (!report.ok()) {
@@ -63,9 +63,9 @@ void Upgrade(const std::string& dir) {
     }
     // Opening as the writer migrates in place: new files first, then one transaction.
     const store::MapStore map = OpenMap(dir, store::MapStore::Access::kWrite);
-    std::cout << dir << ": format " << before << " -> " << map.settings().format_version
-              << " (" << map.TileFileCount() << " fused versions, "
-              << map.Latest().sessions.size() << " sessions)\n";
+    std::cout << dir << ": format " << before << " -> " << map.settings().format_version << " ("
+              << map.TileFileCount() << " fused versions, " << map.Latest().sessions.size()
+              << " sessions)\n";
 }
 
 }  // namespace

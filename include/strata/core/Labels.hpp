@@ -32,7 +32,8 @@ struct Rgb {
 [[nodiscard]] Rgb ClassColor(SemanticClass c);
 /// @brief Parses a class name as printed by ClassName; throws InvalidArgumentError otherwise.
 [[nodiscard]] SemanticClass ClassFromName(const std::string& name);
-/// @brief The legend as a JSON array [{"id":..,"name":..,"color":[r,g,b]}], stored in grid metadata.
+/// @brief The legend as a JSON array [{"id":..,"name":..,"color":[r,g,b]}], stored in grid
+/// metadata.
 [[nodiscard]] std::string LegendJson();
 
 /// @brief Maps the raw class ids of a source format to SemanticClass. Unmapped ids map to kOther

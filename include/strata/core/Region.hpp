@@ -1,10 +1,10 @@
 #pragma once
 
-#include "strata/core/GridTypes.hpp"
-
 #include <Eigen/Core>
 #include <string>
 #include <vector>
+
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::core {
 

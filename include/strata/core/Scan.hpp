@@ -9,8 +9,10 @@
 
 namespace strata::core {
 
-/// @brief One LiDAR sweep: points in the sensor frame, optional per-point data, and the sensor pose.
-/// @note `labels` and `intensity` are either empty or exactly `points.size()` long (Validate checks).
+/// @brief One LiDAR sweep: points in the sensor frame, optional per-point data, and the sensor
+/// pose.
+/// @note `labels` and `intensity` are either empty or exactly `points.size()` long (Validate
+/// checks).
 struct Scan {
     std::vector<Eigen::Vector3d> points;  ///< sensor frame, metres
     std::vector<SemanticClass> labels;    ///< optional, already mapped to strata's classes

@@ -1,24 +1,23 @@
 #pragma once
 
-#include "strata/core/GridTypes.hpp"
-
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
 #include <string>
 
 #include "strata/core/Endpoints.hpp"
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::core {
 
 /// @brief Names of the grids of a map (ARCHITECTURE.md, "Per-voxel data").
 namespace grid_names {
-inline constexpr const char* kOccupancy = "occupancy";      ///< FloatGrid, log-odds
-inline constexpr const char* kLabel = "label";              ///< Int32Grid, SemanticClass
+inline constexpr const char* kOccupancy = "occupancy";       ///< FloatGrid, log-odds
+inline constexpr const char* kLabel = "label";               ///< Int32Grid, SemanticClass
 inline constexpr const char* kLabelWeight = "label_weight";  ///< FloatGrid, vote weight
-inline constexpr const char* kEndpoints = "endpoints";      ///< Int32Grid, hits + mean (packed)
-inline constexpr const char* kHits = "hits";                ///< Int32Grid, exports and old maps
-inline constexpr const char* kPointMean = "point_mean";     ///< Vec3SGrid, exports and old maps
+inline constexpr const char* kEndpoints = "endpoints";       ///< Int32Grid, hits + mean (packed)
+inline constexpr const char* kHits = "hits";                 ///< Int32Grid, exports and old maps
+inline constexpr const char* kPointMean = "point_mean";      ///< Vec3SGrid, exports and old maps
 }  // namespace grid_names
 
 /// @brief The aligned bundle of per-voxel grids that make a map. All grids share one transform:

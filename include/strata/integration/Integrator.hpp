@@ -26,8 +26,8 @@ struct ScanUpdate {
     openvdb::MaskTree::Ptr free;      ///< voxels the rays crossed, endpoints excluded; never null
     openvdb::MaskTree::Ptr occupied;  ///< endpoint voxels; never null
     std::vector<EndpointGroup> endpoints;  ///< sorted by voxel then class
-    size_t points = 0;   ///< points in the scan
-    size_t dropped = 0;  ///< NaN/inf, or closer than min_range_m
+    size_t points = 0;                     ///< points in the scan
+    size_t dropped = 0;                    ///< NaN/inf, or closer than min_range_m
     size_t clipped = 0;  ///< beyond max_range_m: cleared free space, recorded no hit
 };
 

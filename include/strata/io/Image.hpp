@@ -61,7 +61,8 @@ void DrawLabel(RgbImage& image, int x, int y, const std::string& text, int scale
 void WritePng(const RgbImage& image, const std::filesystem::path& path);
 
 /// @brief Reads a PNG of any colour type as 8-bit RGB (alpha dropped, grey expanded); throws
-/// NotFoundError/IoError naming `path` when it cannot be read, FormatError when it cannot be decoded.
+/// NotFoundError/IoError naming `path` when it cannot be read, FormatError when it cannot be
+/// decoded.
 [[nodiscard]] RgbImage ReadPng(const std::filesystem::path& path);
 
 }  // namespace strata::io

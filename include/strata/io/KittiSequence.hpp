@@ -26,8 +26,8 @@ struct KittiSequence {
 /// so a folder holding frames 100-199 pairs with the full poses.txt; other names take their
 /// position in sorted order. `Tr` comes from calib.txt, identity when calib.txt is absent.
 /// @throws NotFoundError naming the file or folder: no velodyne/ or no scans in it, no
-/// poses.txt, a labels/ folder that lacks a scan's .label file; FormatError: fewer poses (or times) than needed (the message gives both counts), a non-finite
-/// pose, calib.txt without `Tr:`,.
+/// poses.txt, a labels/ folder that lacks a scan's .label file; FormatError: fewer poses (or times)
+/// than needed (the message gives both counts), a non-finite pose, calib.txt without `Tr:`,.
 [[nodiscard]] KittiSequence OpenKittiSequence(const std::filesystem::path& dir);
 
 /// @brief Loads scan `index`: points and intensity, labels and instances when the sequence has

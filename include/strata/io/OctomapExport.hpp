@@ -22,9 +22,9 @@ inline constexpr int kOctomapKeyLimit = 32768;
 /// georeference. Voxel (i, j, k) becomes OctoMap key (i + 32768, j + 32768, k + 32768), so voxel
 /// centres coincide.
 /// @note Throws InvalidArgumentError for another extension, RefusedError when the map is
-/// larger than OctoMap's key range (the message gives the extent and the limit), IoError on I/O failure
-/// (naming `path`; nothing is left behind: temporary file + rename). Sequential; memory is that
-/// of the OctoMap tree (about 40-80 bytes per voxel).
+/// larger than OctoMap's key range (the message gives the extent and the limit), IoError on I/O
+/// failure (naming `path`; nothing is left behind: temporary file + rename). Sequential; memory is
+/// that of the OctoMap tree (about 40-80 bytes per voxel).
 void WriteOctomap(const core::VoxelMap& map, const std::filesystem::path& path);
 
 }  // namespace strata::io

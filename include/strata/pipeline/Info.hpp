@@ -2,7 +2,6 @@
 // What a map holds, as `strata info --json` prints it and Python's `Map.info()` returns it.
 
 #include <nlohmann/json.hpp>
-
 #include <string>
 
 #include "strata/store/MapStore.hpp"

@@ -30,10 +30,10 @@ struct ProductCommit {
 
 /// @brief One row an analysis stored.
 struct ProductRow {
-    int64_t id = 0;      ///< unique in the map, increasing
-    int64_t commit = 0;  ///< the commit that stored it
+    int64_t id = 0;        ///< unique in the map, increasing
+    int64_t commit = 0;    ///< the commit that stored it
     std::string time_utc;  ///< when that commit was made (ISO 8601)
-    std::string json;    ///< the object as the analysis gave it
+    std::string json;      ///< the object as the analysis gave it
 };
 
 }  // namespace strata::store

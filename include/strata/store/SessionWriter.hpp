@@ -38,11 +38,11 @@ struct SessionOptions {
 
 /// @brief What a session writer did, for progress reports and benchmarks.
 struct WriterStats {
-    size_t tiles_loaded = 0;   ///< read from the map (or back from an eviction)
-    size_t tiles_evicted = 0;  ///< moved out of memory to honour the budget
-    size_t tiles_written = 0;  ///< fused versions written, evictions included
-    size_t layers_written = 0;  ///< layer files of this session written, evictions included
-    uint64_t bytes_written = 0;  ///< fused and layer files together
+    size_t tiles_loaded = 0;       ///< read from the map (or back from an eviction)
+    size_t tiles_evicted = 0;      ///< moved out of memory to honour the budget
+    size_t tiles_written = 0;      ///< fused versions written, evictions included
+    size_t layers_written = 0;     ///< layer files of this session written, evictions included
+    uint64_t bytes_written = 0;    ///< fused and layer files together
     size_t peak_memory_bytes = 0;  ///< largest working set seen (grids of loaded tiles)
     double commit_seconds = 0.0;
 };
