@@ -6,10 +6,12 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
 #include "strata/columns/ColumnPicture.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::tools {
@@ -28,9 +30,11 @@ struct WallsArgs {
     std::string columns_png;
     std::string columns_vdb;
     bool no_save = false;
+    double memory_budget_mb = 512.0;
 };
 
-void PrintSummary(const walls::WallResult& result, const store::MapStore& map) {
+void PrintSummary(const pipeline::WallsOutcome& outcome, const store::MapStore& map) {
+    const walls::WallResult& result = outcome.result;
     const walls::WallStats& s = result.stats;
     std::cout << map.dir().string() << ": " << result.walls.size() << " walls from "
               << s.candidate_voxels << " candidate voxels (" << s.voting_columns << " of "
@@ -46,6 +50,11 @@ void PrintSummary(const walls::WallResult& result, const store::MapStore& map) {
                      "by up to that much (--level-to-ground measures against the ground)";
     }
     std::cout << "\n";
+    if (outcome.tile_groups > 0) {
+        std::cout << "read tile by tile within --memory-budget: " << outcome.tile_groups
+                  << " groups of tiles, " << outcome.kept_bytes / 1000000.0
+                  << " MB kept across them\n";
+    }
     std::cout << "   id   slant deg  +-1 sigma  lean az  length m  height m  inliers  rms m   "
                  "centroid (map frame)\n";
     for (const walls::Wall& w : result.walls) {
@@ -64,8 +73,21 @@ void Run(const WallsArgs& args) {
     const bool save = !args.no_save && args.as_of.empty();
     store::MapStore map =
         OpenMap(args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    const pipeline::WallsOutcome outcome =
-        pipeline::FindWalls(map, SelectSnapshot(map, args.as_of), args.config);
+    const store::Snapshot snapshot = SelectSnapshot(map, args.as_of);
+    const auto budget = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    // The slant picture and the column statistics cover the whole map: read tile by tile, only
+    // the voxels near wall candidates are kept, so they are refused rather than drawn partly.
+    const bool whole_map_outputs = !args.png.empty() || !args.columns_csv.empty() ||
+                                   !args.columns_png.empty() || !args.columns_vdb.empty();
+    if (whole_map_outputs && !pipeline::WallsReadWhole(map, snapshot, budget)) {
+        std::ostringstream mb;
+        mb << args.memory_budget_mb;
+        throw RefusedError(map.dir().string() + ": --png and --columns-* draw the whole map, " +
+                           "which exceeds --memory-budget " + mb.str() +
+                           " MB; raise --memory-budget (0: no limit) or leave them out (the " +
+                           "walls, --csv, --vdb and --json are found tile by tile)");
+    }
+    const pipeline::WallsOutcome outcome = pipeline::FindWalls(map, snapshot, args.config, budget);
     const core::VoxelMap& voxels = outcome.map;
     const walls::WallResult& result = outcome.result;
 
@@ -86,7 +108,7 @@ void Run(const WallsArgs& args) {
     if (args.json) {
         std::cout << walls::WallsJson(result, args.config, voxels.origin);
     } else {
-        PrintSummary(result, map);
+        PrintSummary(outcome, map);
     }
     if (save) {
         const int64_t commit = pipeline::StoreWalls(map, outcome);
@@ -109,6 +131,7 @@ void RegisterWalls(CLI::App& app) {
         "  strata walls street.strata --png slant.png --csv walls.csv\n"
         "  strata walls street.strata --json --no-save\n"
         "  strata walls street.strata --columns-png columns.png --columns-vdb columns.vdb\n"
+        "  strata walls district.strata --memory-budget 256 --csv walls.csv  # tile by tile\n"
         "Stores the slant_deg and wall_id grids and the walls table in the map (one commit)\n"
         "unless --no-save or --as-of is given. docs/walls.md explains every stage and option.");
     walls::WallConfig& c = args->config;
@@ -124,6 +147,11 @@ void RegisterWalls(CLI::App& app) {
     cmd->add_option("--columns-vdb", args->columns_vdb,
                     "Write the column statistics as 2D grids to a .vdb file");
     cmd->add_flag("--no-save", args->no_save, "Do not store the products in the map");
+    cmd->add_option("--memory-budget", args->memory_budget_mb,
+                    "MB: a map whose fused grids exceed it is read a group of tiles at a time, "
+                    "with a halo (the same walls); 0: read whole")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     cmd->add_flag("--level-to-ground", c.level_to_ground,
                   "Measure slants against the ground plane's normal, not the map's z axis");
     cmd->add_option("--window", c.window_m, "Side of the sliding column window (m)")
