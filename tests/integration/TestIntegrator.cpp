@@ -6,6 +6,7 @@
 #include <set>
 #include <tuple>
 
+#include "MapDiff.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
 
@@ -199,20 +200,29 @@ TEST(Integrator, LabelFlipsOnlyWhenOutweighed) {
     EXPECT_NEAR(map.label_weight->tree().getValue(v), 1.0f, kValueTol);
 }
 
+// Every grid of both maps, voxel by voxel: occupancy, label, label weight and endpoints (hits
+// and point means).
 void ExpectSameGrids(const core::VoxelMap& a, const core::VoxelMap& b) {
-    ASSERT_EQ(a.occupancy->activeVoxelCount(), b.occupancy->activeVoxelCount());
-    auto acc = b.occupancy->getConstAccessor();
-    for (auto it = a.occupancy->cbeginValueOn(); it; ++it) {
-        ASSERT_TRUE(acc.isValueOn(it.getCoord()));
-        ASSERT_EQ(acc.getValue(it.getCoord()), *it) << it.getCoord();
+    EXPECT_EQ(strata::testing::MapDifference(a, b), "");
+}
+
+// The room's scans with a class per point (walls building, floor ground, a few vehicle points
+// mixed in), so that label fusion and its weights take part in the comparisons.
+core::Scan LabelledRoomScan(uint32_t seed, size_t n) {
+    core::Scan scan = RoomScan(seed, n);
+    for (size_t i = 0; i < scan.points.size(); ++i) {
+        const bool floor = scan.points[i].z() < -1.5 + 1e-6;  // sensor frame: the room's floor
+        scan.labels.push_back(i % 7 == 0 ? core::SemanticClass::kVehicle
+                              : floor    ? core::SemanticClass::kGround
+                                         : core::SemanticClass::kBuilding);
     }
-    EXPECT_EQ(a.endpoints->activeVoxelCount(), b.endpoints->activeVoxelCount());
+    return scan;
 }
 
 core::VoxelMap IntegrateRoom(const IntegrationConfig& config) {
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     Integrator integrator(map, config);
-    for (uint32_t seed = 1; seed <= 3; ++seed) integrator.Integrate(RoomScan(seed, 20000));
+    for (uint32_t seed = 1; seed <= 3; ++seed) integrator.Integrate(LabelledRoomScan(seed, 20000));
     return map;
 }
 
@@ -227,6 +237,8 @@ TEST(Integrator, ResultDoesNotDependOnThreadCount) {
         four = IntegrateRoom(IntegrationConfig{});
     }
     EXPECT_GT(one.occupancy->activeVoxelCount(), 10000u);
+    EXPECT_GT(one.label->activeVoxelCount(), 1000u);
+    EXPECT_GT(one.endpoints->activeVoxelCount(), 1000u);
     ExpectSameGrids(one, four);
 }
 

@@ -233,23 +233,49 @@ TEST(Store, RemovingASessionRebuildsOnlyWhatItSaw) {
     auto first_acc = only_first.occupancy->getConstAccessor();
     auto second_acc = only_second.occupancy->getConstAccessor();
     auto after_acc = after.occupancy->getConstAccessor();
-    size_t kept = 0, forgotten = 0;
+    // Every grid of a voxel: occupancy, label, label weight, endpoint (hits and point mean).
+    const auto same_voxel = [&](const openvdb::Coord& ijk) {
+        return after_acc.getValue(ijk) == before.occupancy->tree().getValue(ijk) &&
+               after.label->tree().isValueOn(ijk) == before.label->tree().isValueOn(ijk) &&
+               after.label->tree().getValue(ijk) == before.label->tree().getValue(ijk) &&
+               after.label_weight->tree().getValue(ijk) ==
+                   before.label_weight->tree().getValue(ijk) &&
+               after.endpoints->tree().isValueOn(ijk) == before.endpoints->tree().isValueOn(ijk) &&
+               after.endpoints->tree().getValue(ijk) == before.endpoints->tree().getValue(ijk);
+    };
+    const auto nothing_but_occupancy = [&](const openvdb::Coord& ijk) {
+        return !after.label->tree().isValueOn(ijk) && !after.label_weight->tree().isValueOn(ijk) &&
+               !after.endpoints->tree().isValueOn(ijk);
+    };
+    size_t kept = 0, forgotten = 0, both_occupied = 0, both_free = 0;
     for (auto it = before.occupancy->cbeginValueOn(); it; ++it) {
         const openvdb::Coord ijk = it.getCoord();
         const bool seen1 = first_acc.isValueOn(ijk), seen2 = second_acc.isValueOn(ijk);
-        if (!seen2) {  // untouched by the removed session: bit-identical
-            EXPECT_EQ(after_acc.getValue(ijk), *it);
+        if (!seen2) {  // untouched by the removed session: bit-identical in every grid
+            EXPECT_TRUE(same_voxel(ijk)) << ijk;
             ++kept;
-        } else if (!seen1) {  // only the removed session saw it: unknown again
+        } else if (!seen1) {  // only the removed session saw it: unknown again, in every grid
             EXPECT_FALSE(after_acc.isValueOn(ijk));
+            EXPECT_TRUE(nothing_but_occupancy(ijk)) << ijk;
             ++forgotten;
         } else {  // both: one vote of session 1, same sign as session 1's own evidence
             ASSERT_TRUE(after_acc.isValueOn(ijk));
             EXPECT_EQ(after_acc.getValue(ijk) > 0.0f, first_acc.getValue(ijk) > 0.0f);
+            if (after_acc.getValue(ijk) > 0.0f) {  // still occupied: its semantics stay
+                EXPECT_EQ(after.label->tree().getValue(ijk), before.label->tree().getValue(ijk));
+                EXPECT_EQ(after.endpoints->tree().isValueOn(ijk),
+                          before.endpoints->tree().isValueOn(ijk));
+                ++both_occupied;
+            } else {  // free now: no label, no endpoint
+                EXPECT_TRUE(nothing_but_occupancy(ijk)) << ijk;
+                ++both_free;
+            }
         }
     }
     EXPECT_GT(kept, 1000u);
     EXPECT_GT(forgotten, 1000u);
+    EXPECT_GT(both_free, 1000u);
+    EXPECT_GT(both_occupied + both_free, 1000u);
     for (const LayerFile& layer : latest.layers) EXPECT_EQ(layer.session, 1);
     EXPECT_FALSE(map.SessionLayers(2).empty());  // kept for history until gc drops them
     // History still holds the session.
