@@ -5,7 +5,8 @@
 //
 // Exits 1 when the garage misses a target docs/vehicles.md states as met (labels, 0.05 m voxels:
 // Chamfer-L1 <= 0.02 m, F-score >= 98 %, >= 90 % of the boxes, no refilled gap cell, refill
-// better than clearing alone); CTest runs it with --accuracy-only (label bench).
+// better than clearing alone) or a row of its accuracy table (kDocumented: counts exactly, errors
+// within 2.5x); CTest runs it with --accuracy-only (label bench).
 // Maps are integrated in memory first (all cores, outside any timing). ClearVehicles runs with
 // all cores (its Embree checks are parallel) and on one core.
 #include <tbb/global_control.h>
@@ -56,6 +57,51 @@ bool Target(bool ok, const char* what) {
     return ok;
 }
 
+// docs/vehicles.md's accuracy table, row by row, as measured (2026-12-02): box counts and false
+// positives held exactly (the garage and the pipeline are deterministic); each error held at
+// kSlack times its measured value, each score at kSlack times its measured shortfall.
+struct DocumentedRow {
+    double voxel;
+    const char* name;
+    size_t matched, false_positives;
+    double mean_iou, accuracy_m, completeness_m, chamfer_m, fscore;
+};
+constexpr double kSlack = 2.5;
+constexpr DocumentedRow kDocumented[] = {
+    {0.05, "labels, cleared only", 43, 0, 0.93, 0.0083, 0.0636, 0.0360, 0.934},
+    {0.05, "labels, refill without ray check", 43, 0, 0.93, 0.0074, 0.0270, 0.0172, 0.992},
+    {0.05, "labels, cleared + refill", 43, 0, 0.93, 0.0074, 0.0269, 0.0172, 0.992},
+    {0.05, "no labels (geometric), cleared + refill", 38, 10, 0.89, 0.0366, 0.0281, 0.0324, 0.970},
+    {0.10, "labels, cleared only", 43, 0, 0.95, 0.0075, 0.0758, 0.0417, 0.930},
+    {0.10, "labels, cleared + refill", 43, 0, 0.95, 0.0071, 0.0413, 0.0242, 0.991},
+    {0.10, "no labels (geometric), cleared + refill", 37, 1, 0.87, 0.0145, 0.0431, 0.0288, 0.982},
+};
+
+// Holds a row of the table to its documented values; prints each miss.
+bool AsDocumented(double voxel, const char* name, const strata::testing::VehicleScore& s) {
+    for (const DocumentedRow& d : kDocumented) {
+        if (d.voxel != voxel || std::string(d.name) != name) continue;
+        const auto& f = s.surface;
+        bool ok = true;
+        const auto check = [&](bool held, const char* what) {
+            if (!held) {
+                std::fprintf(stderr, "bench_vehicles: %.2f m, %s: %s off docs/vehicles.md\n", voxel,
+                             name, what);
+            }
+            ok &= held;
+        };
+        check(s.matched == d.matched, "boxes matched");
+        check(s.false_positives == d.false_positives, "false positives");
+        check(1.0 - s.mean_iou <= kSlack * (1.0 - d.mean_iou), "mean IoU");
+        check(f.accuracy_m <= kSlack * d.accuracy_m, "accuracy");
+        check(f.completeness_m <= kSlack * d.completeness_m, "completeness");
+        check(f.chamfer_l1_m <= kSlack * d.chamfer_m, "Chamfer-L1");
+        check(1.0 - f.fscore <= kSlack * (1.0 - d.fscore), "F-score");
+        return ok;
+    }
+    return true;  // a row the table does not list
+}
+
 // Prints the accuracy table; returns false when a target is missed.
 bool Accuracy() {
     std::printf(
@@ -77,6 +123,7 @@ bool Accuracy() {
             const auto score = strata::testing::ScoreVehicles(c, map, result);
             PrintScore(v.c_str(), name, score, true);
             met &= Target(score.gap_cells_refilled == 0, "a refilled cell in a real gap");
+            met &= AsDocumented(voxel, name, score);
             return score;
         };
         VehicleConfig labels;

@@ -94,13 +94,18 @@ TEST(ChangeSimulated, Ablation) {
         "objects | precision | recall | IoU | IoU (strict) |\n");
     struct Row {
         int tolerance, margin, grow, support;
-        size_t objects;  // measured 2026-12-02
-        double iou;
+        size_t objects;  // measured 2026-12-02 (docs/change.md)
+        double precision, recall, iou, strict_iou;
     };
-    const Row rows[] = {{0, 0, 0, 0, 229, 0.946}, {1, 0, 0, 0, 69, 0.824}, {0, 1, 0, 0, 94, 0.955},
-                        {1, 1, 0, 0, 7, 0.809},   {1, 1, 2, 0, 7, 0.939},  {2, 1, 2, 0, 7, 0.916},
-                        {2, 1, 2, 3, 7, 0.916},   {2, 2, 2, 3, 7, 0.873}};
-    // Pooled IoU moves by a few thousandths when a handful of voxels change.
+    const Row rows[] = {
+        {0, 0, 0, 0, 229, 0.017, 0.571, 0.946, 0.911}, {1, 0, 0, 0, 69, 0.101, 1.0, 0.824, 0.854},
+        {0, 1, 0, 0, 94, 0.074, 1.0, 0.955, 0.936},    {1, 1, 0, 0, 7, 1.0, 1.0, 0.809, 0.841},
+        {1, 1, 2, 0, 7, 1.0, 1.0, 0.939, 0.926},       {2, 1, 2, 0, 7, 1.0, 1.0, 0.916, 0.944},
+        {2, 1, 2, 3, 7, 1.0, 1.0, 0.916, 0.944},       {2, 2, 2, 3, 7, 1.0, 1.0, 0.873, 0.900}};
+    // The scene and the query are deterministic: object counts exact, precision and recall to
+    // the table's three decimals; pooled IoU moves by a few thousandths when a handful of voxels
+    // change, so it is held to 0.02 (under a third of the smallest shortfall, 0.045).
+    constexpr double kRatioTolerance = 0.0005;
     constexpr double kIoUTolerance = 0.02;
     std::vector<ChangeScore> scores;
     for (const Row& row : rows) {
@@ -114,16 +119,13 @@ TEST(ChangeSimulated, Ablation) {
         std::printf("[ change ] | %d | %d | %d | %d | %zu | %.3f | %.3f | %.3f | %.3f |\n",
                     row.tolerance, row.margin, row.grow, row.support, mapped.objects,
                     mapped.precision, mapped.recall, mapped.iou, strict.iou);
-        EXPECT_NEAR(mapped.iou, row.iou, kIoUTolerance) << row.tolerance << row.margin << row.grow;
-        if (row.objects == s.edits.size()) {
-            EXPECT_EQ(mapped.objects, row.objects);
-            EXPECT_EQ(mapped.precision, 1.0);
-            EXPECT_EQ(mapped.recall, 1.0);
-        } else {  // false objects by the dozen: within a factor of 2 of the measured count
-            EXPECT_GE(2 * mapped.objects, row.objects);
-            EXPECT_LE(mapped.objects, 2 * row.objects);
-            EXPECT_LT(mapped.precision, 0.2);
-        }
+        SCOPED_TRACE(std::to_string(row.tolerance) + std::to_string(row.margin) +
+                     std::to_string(row.grow) + std::to_string(row.support));
+        EXPECT_EQ(mapped.objects, row.objects);
+        EXPECT_NEAR(mapped.precision, row.precision, kRatioTolerance);
+        EXPECT_NEAR(mapped.recall, row.recall, kRatioTolerance);
+        EXPECT_NEAR(mapped.iou, row.iou, kIoUTolerance);
+        EXPECT_NEAR(strict.iou, row.strict_iou, kIoUTolerance);
         scores.push_back(mapped);
     }
     EXPECT_GT(scores[4].iou, scores[3].iou) << "growth gives back voxels the safeguards trimmed";
@@ -151,7 +153,9 @@ TEST(ChangeSimulated, NothingIsReportedWhereOneSessionNeverLooked) {
         }
     }
     std::printf("[ change ] %zu voxels reported, %zu of them unseen by a side\n", reported, unseen);
-    EXPECT_GE(reported, 1800u) << "the seven edits are reported (measured 3,614 voxels)";
+    // The seven edits: 3,614 voxels measured (docs/change.md); a few voxels either way when the
+    // change rules are retuned, not a factor.
+    EXPECT_NEAR(static_cast<double>(reported), 3614.0, 0.01 * 3614.0);
     EXPECT_EQ(unseen, 0u);
 }
 

@@ -42,6 +42,12 @@ constexpr double kMinMeanIoU = 0.9;
 constexpr double kMinMatchedFractionGeometric = 0.8;  // the garage's
 constexpr size_t kMaxFalseVehiclesGeometric = 70;
 constexpr double kMinMeanIoUGeometric = 0.75;
+// What the small district measured (docs/simulator.md, "Districts"), held exactly: the scene, the
+// simulator and the analyses are deterministic (gcc 12 and clang 14 give the same counts).
+constexpr size_t kWallsFound = 42;  // of 43: b1_1_n1's front is half hidden by parked vans
+constexpr size_t kVegetationAsWall = 1;
+constexpr size_t kLabelBoxesMatched = 120, kLabelFalseBoxes = 0;
+constexpr size_t kGeometricBoxesMatched = 100, kGeometricFalseBoxes = 35;
 constexpr double kMinPrecision = 0.95;  // the change targets, as for the two-session street
 constexpr double kMinRecall = 0.95;
 constexpr double kMinIoU = 0.9;
@@ -125,6 +131,8 @@ void ExpectWallSlantsAsOnTheStreet(const District& d) {
     EXPECT_LE(s.max_error, kMaxSlantErrorDeg);
     EXPECT_LE(s.vegetation_as_wall, kMaxVegetationAsWall * static_cast<double>(s.vegetation));
     EXPECT_GE(s.vegetation, 10U) << "the district's trees and bushes are looked at";
+    EXPECT_EQ(s.found, kWallsFound);
+    EXPECT_EQ(s.vegetation_as_wall, kVegetationAsWall);
 }
 
 void ExpectVehicleBoxesAsInTheGarage(const District& d) {
@@ -153,6 +161,8 @@ void ExpectVehicleBoxesAsInTheGarage(const District& d) {
                                  static_cast<double>(s.truth));
         EXPECT_LE(s.false_positives, labels ? kMaxFalseVehicles : kMaxFalseVehiclesGeometric);
         EXPECT_GE(s.mean_iou, labels ? kMinMeanIoU : kMinMeanIoUGeometric);
+        EXPECT_EQ(s.matched, labels ? kLabelBoxesMatched : kGeometricBoxesMatched);
+        EXPECT_EQ(s.false_positives, labels ? kLabelFalseBoxes : kGeometricFalseBoxes);
     }
 }
 
@@ -170,6 +180,9 @@ void ExpectChangesAsOnTheTwoSessionStreet(const District& d) {
         EXPECT_GE(s.recall, kMinRecall);
         EXPECT_GE(s.iou, kMinIoU);
         EXPECT_GE(strict.iou, kMinIoU);
+        EXPECT_EQ(s.objects, c.edits.size()) << "each edit one object, nothing else";
+        EXPECT_EQ(s.precision, 1.0);
+        EXPECT_EQ(s.recall, 1.0);
     }
 }
 

@@ -134,10 +134,8 @@ TEST(Store, CommitsWriteTheSameBytesWhateverTheMapsAge) {
         EXPECT_EQ(writer.stats().layers_written, writer.stats().tiles_written);
     }
     // Session 2 onwards re-observes the same voxels: fused files keep their size, and every
-    // session's layers are the same. Measured: equal to the byte; 1 % allows encoding jitter.
-    constexpr double kFlatRatio = 1.01;
-    EXPECT_LE(static_cast<double>(written.back()), kFlatRatio * static_cast<double>(written[1]));
-    EXPECT_GE(static_cast<double>(written.back()), static_cast<double>(written[1]) / kFlatRatio);
+    // session's layers are the same: equal to the byte (docs/store.md).
+    EXPECT_EQ(written.back(), written[1]);
     const StorageBytes bytes = map.Bytes(map.Latest());
     EXPECT_EQ(bytes.layers, SumBytes(map.Latest().layers));
     EXPECT_GT(bytes.fused_older, 6 * bytes.fused_current);  // seven superseded versions per tile

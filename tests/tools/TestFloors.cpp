@@ -15,10 +15,13 @@ namespace {
 
 using nlohmann::json;
 
-// Issue #8 targets for stacking; localization of one scan within the same 0.05 m.
-constexpr double kXyTolM = 0.05;
-constexpr double kYawTolDeg = 0.2;
-constexpr double kMaxZErrorRate = 0.01;
+// The program gives the library's stacking (tests/registration/TestFloors.cpp): held at the same
+// 2-3x of what docs/registration.md measured (x 0.023 m, y 0.004 m, yaw 0.017 deg, z rate
+// 0.00034); localization of one scan within issue #8's 0.05 m.
+constexpr double kXTolM = 0.05;
+constexpr double kYTolM = 0.008;
+constexpr double kYawTolDeg = 0.04;
+constexpr double kMaxZErrorRate = 0.001;
 constexpr double kLocalizeTolM = 0.05;
 // Exit codes of the kinds of error (tools/strata/Main.cpp).
 constexpr int kExitUsage = 2, kExitRefused = 4;
@@ -46,8 +49,8 @@ void ExpectSameXyYaw(const Eigen::Isometry3d& T, const Eigen::Isometry3d& truth,
                      const std::string& what) {
     const Eigen::Vector3d dt = T.translation() - truth.translation();
     const Eigen::Matrix3d dR = truth.linear().transpose() * T.linear();
-    EXPECT_LT(std::abs(dt.x()), kXyTolM) << what;
-    EXPECT_LT(std::abs(dt.y()), kXyTolM) << what;
+    EXPECT_LT(std::abs(dt.x()), kXTolM) << what;
+    EXPECT_LT(std::abs(dt.y()), kYTolM) << what;
     EXPECT_LT(std::abs(std::atan2(dR(1, 0), dR(0, 0))) * 180 / M_PI, kYawTolDeg) << what;
 }
 

@@ -141,10 +141,12 @@ TEST(RegistrationCli, RegistersAKitti00ScanOnTheRawPointOptimum) {
 
 TEST(RegistrationCli, RefusesAGuessFarOffAndSaysWhy) {
     const Street& s = StreetData();
+    const auto before = MapFiles(s.map);
     const Result r = Strata("register " + s.map.string() + " --kitti " + s.seq.string() +
                             " --frames 6:12 --init 3,2,0,120");
     EXPECT_EQ(r.code, kExitRefused) << r.out;
     EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
+    EXPECT_EQ(MapFiles(s.map), before);  // a refused registration writes nothing
 }
 
 TEST(RegistrationCli, BadInputFailsNamingTheProblem) {
