@@ -2,7 +2,9 @@
 // for a scan against a map (KITTI 00), a session against a map (BALM halves) and scan-to-slice
 // localization in the simulated building; then strata against the raw-point ICP on every real
 // pair (RegistrationPairs.cpp). Prints two markdown tables; exits 1 when a pair misses the
-// 0.05 deg target.
+// 0.05 deg target, or a row of the first table errs by more than 2.5x what docs/registration.md
+// measured (CTest: bench_registration.AccuracyTargets, label bench). Without ../shared/data the
+// real-data rows are left out, which STRATA_REQUIRE_DATA=1 (CI) turns into a failure.
 //
 //   bench_registration [DATA_DIR] [--repeat N]
 //
@@ -13,6 +15,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <string>
@@ -54,11 +57,41 @@ struct Row {
     std::string note;
 };
 
-void Print(const Row& r, int repeat) {
+void Print(const Row& r) {
     std::printf("| %s | %zu | %zu | %.1f | %.1f | %.3f | %.3f | %s |\n", r.name.c_str(),
                 r.map_points, r.source_points, r.surface_ms, r.register_ms, r.error_m, r.error_deg,
                 r.note.c_str());
-    (void)repeat;
+}
+
+// The errors docs/registration.md measured for the rows of the first table (2026-12-02), held at
+// kSlack times; the runs are deterministic on one thread.
+constexpr double kSlack = 2.5;
+struct Documented {
+    double error_m, error_deg;
+};
+constexpr Documented kKitti{0.003, 0.008}, kBalm{0.003, 0.014}, kLocalization{0.008, 0.0};
+
+// Prints the row; returns false (and says why) when it errs by more than kSlack x `doc` or was
+// refused.
+bool PrintHeld(const Row& r, const Documented& doc) {
+    Print(r);
+    const bool held = r.note.rfind("refused", 0) != 0 && r.error_m <= kSlack * doc.error_m &&
+                      r.error_deg <= std::max(kSlack * doc.error_deg, 1e-9);
+    if (!held) {
+        std::fprintf(stderr,
+                     "bench_registration: %s: %.4f m / %.4f deg, documented %.3f m / %.3f deg\n",
+                     r.name.c_str(), r.error_m, r.error_deg, doc.error_m, doc.error_deg);
+    }
+    return held;
+}
+
+// True when real data is required (CI) but `file` is missing; says so.
+bool MissingRequired(const fs::path& file) {
+    const char* require = std::getenv("STRATA_REQUIRE_DATA");
+    if (fs::exists(file) || require == nullptr || std::string(require) != "1") return false;
+    std::fprintf(stderr, "bench_registration: STRATA_REQUIRE_DATA=1 and %s is missing\n",
+                 file.c_str());
+    return true;
 }
 
 // `source` to `map_points` from `guess`, `repeat` times on one core: median times, last result.
@@ -86,7 +119,9 @@ Row Time(const std::string& name, const std::vector<Eigen::Vector3d>& map_points
             r.converged ? "accepted" : "refused: " + r.refusal};
 }
 
+// Prints the first table; returns the number of rows that miss their documented errors.
 int Run(const fs::path& data, int repeat) {
+    int misses = 0;
     std::printf(
         "| case | map points | source points | surface ms | registration ms (median of %d, 1 "
         "core) | error m | error deg | |\n|---|---|---|---|---|---|---|---|\n",
@@ -105,9 +140,12 @@ int Run(const fs::path& data, int repeat) {
                 .Align(reg::test::RangeFiltered(k.scans[5], 3.0, 60.0),
                        k.orbslam2[0].inverse() * k.orbslam2[5])
                 .mean;
-        Print(Time("KITTI 00 frame 5 -> map of frame 0 (0.2 m), guess 1 m / 5 deg off", points,
-                   k.scans[5], off * optimum, optimum, scan_config, repeat),
-              repeat);
+        misses +=
+            !PrintHeld(Time("KITTI 00 frame 5 -> map of frame 0 (0.2 m), guess 1 m / 5 deg off",
+                            points, k.scans[5], off * optimum, optimum, scan_config, repeat),
+                       kKitti);
+    } else {
+        misses += MissingRequired(data / "kitti00/poses_sptam.txt");
     }
     if (fs::exists(data / "balm/poses.txt")) {
         const auto scans = strata::bench::LoadKittiScans(data / "balm");
@@ -123,9 +161,12 @@ int Run(const fs::path& data, int repeat) {
         const reg::Surface s = reg::Surface::FromPoints(points, config.surface);
         const Eigen::Isometry3d base =
             reg::RegisterPoints(s, unmoved, Eigen::Isometry3d::Identity(), config).T_map_source;
-        Print(Time("BALM second half (moved 5 m / 25 deg) -> first half (0.2 m)", points, cloud,
-                   off * move.inverse(), base * move.inverse(), config, repeat),
-              repeat);
+        misses +=
+            !PrintHeld(Time("BALM second half (moved 5 m / 25 deg) -> first half (0.2 m)", points,
+                            cloud, off * move.inverse(), base * move.inverse(), config, repeat),
+                       kBalm);
+    } else {
+        misses += MissingRequired(data / "balm/poses.txt");
     }
     // Localization in the simulated building's floor-1 slice, scan after scan.
     const fs::path dir =
@@ -173,10 +214,10 @@ int Run(const fs::path& data, int repeat) {
     row.register_ms = Median(ms);
     row.error_m = std::sqrt(sum2 / double(ms.size()));
     row.note = "error = RMSE over " + std::to_string(ms.size()) + " scans; ms = median per scan";
-    Print(row, repeat);
+    misses += !PrintHeld(row, kLocalization);
     std::error_code ignored;
     fs::remove_all(dir, ignored);
-    return 0;
+    return misses;
 }
 
 }  // namespace
@@ -184,15 +225,14 @@ int Run(const fs::path& data, int repeat) {
 int main(int argc, char** argv) {
     try {
         const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
-        if (Run(args.data, args.repeat) != 0) return 1;
+        const int row_misses = Run(args.data, args.repeat);
         std::printf("\n");
         const int misses = strata::bench::PrintRegistrationPairs(args.data, args.repeat);
         if (misses > 0) {
             std::fprintf(stderr, "bench_registration: %d pair(s) miss the 0.05 deg target\n",
                          misses);
-            return 1;
         }
-        return 0;
+        return row_misses + misses > 0 ? 1 : 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_registration: %s\n", e.what());
         return 1;

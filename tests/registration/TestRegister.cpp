@@ -76,6 +76,9 @@ TEST(RegistrationIcp, RefusesACloudOfAnotherPlace) {
     EXPECT_FALSE(r.converged) << r.brief_report << r.overlap << " " << r.rmse_m << " "
                               << r.eigenvalues.transpose();
     EXPECT_FALSE(r.refusal.empty());
+    // Refused for its overlap: measured 0.35 (docs/registration.md), below min_overlap 0.5.
+    EXPECT_LT(r.overlap, config.min_overlap);
+    EXPECT_GT(r.overlap, 0.35 / 2.5);
 }
 
 TEST(RegistrationIcp, RefusesADegenerateCorridor) {

@@ -114,6 +114,8 @@ TEST(RegistrationRealDataOuster, TheTwoScansAreOfTwoPlacesAndRegistrationRefuses
          {Eigen::Isometry3d::Identity(), pair.icp.T_target_source}) {
         const RegistrationResult r = RegisterScan(map, b, guess);
         EXPECT_FALSE(r.converged) << "overlap " << r.overlap;
+        // Refused for its overlap: measured 0.10 (docs/registration.md), held at 2.5x.
+        EXPECT_LT(r.overlap, 0.25);
         std::cout << "strata: " << r.refusal << "\n";
     }
 }

@@ -147,6 +147,15 @@ TEST(District, FullDistrictIsAboutOneKilometreSquareWithThreeSessions) {
     EXPECT_EQ(spec.sessions[2].trajectory.max_scans, 576);
     EXPECT_EQ(walls, 950U);
     EXPECT_EQ(vehicles, 2256U);
+    EXPECT_EQ(spec.objects.size(), 5064U);  // docs/simulator.md, "Districts"
+    // Edits as the ground truth counts them: a moved car is one that left and one that arrived.
+    const auto changes = [](const SessionSpec& session) {
+        size_t n = 0;
+        for (const EditSpec& e : session.edits) n += e.kind == EditSpec::Kind::kMove ? 2 : 1;
+        return n;
+    };
+    EXPECT_EQ(changes(spec.sessions[1]), 44U);
+    EXPECT_EQ(changes(spec.sessions[2]), 29U);
 }
 
 }  // namespace strata::sim
