@@ -8,6 +8,7 @@
 #include "strata/core/Labels.hpp"
 #include "strata/core/ParallelFor.hpp"
 #include "strata/pipeline/MapAccess.hpp"
+#include "strata/pipeline/Sessions.hpp"
 #include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline {
@@ -114,16 +115,7 @@ nlohmann::json DescribeMap(const store::MapStore& store, const std::string& as_o
                   {"catalog", DiskUse(store.dir(), "catalog.sqlite")}};
     j["disk_bytes"] = DiskUse(store.dir());  // catalog, all files, garbage
     j["sessions"] = nlohmann::json::array();
-    for (const auto& s : snapshot.sessions) {
-        j["sessions"].push_back({{"id", s.id},
-                                 {"name", s.name},
-                                 {"source", s.source},
-                                 {"scans", s.scans},
-                                 {"points", s.points},
-                                 {"start_utc", s.start_utc},
-                                 {"end_utc", s.end_utc},
-                                 {"commit", s.commit}});
-    }
+    for (const auto& s : snapshot.sessions) j["sessions"].push_back(SessionJson(s));
     return j;
 }
 

@@ -10,8 +10,12 @@
 
 namespace strata::pipeline {
 
-/// @brief Every session ever committed, oldest first: id, name, source, scans, points,
-/// start_utc, end_utc, commit and removed_commit (0 while alive).
+/// @brief One session as `info --json` and `session list --json` print it: id, name, source,
+/// scans, points, start_utc, end_utc, commit.
+[[nodiscard]] nlohmann::json SessionJson(const store::SessionRecord& session);
+
+/// @brief Every session ever committed, oldest first: SessionJson's keys and removed_commit (0
+/// while alive).
 [[nodiscard]] nlohmann::json SessionHistoryJson(const store::MapStore& map);
 
 /// @brief The session removed and the commit that removed it.
