@@ -104,8 +104,14 @@ else
   export LD_LIBRARY_PATH="$tbb_lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
   cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_SANITIZE=thread >/dev/null
   cmake --build "$build" -j "$jobs" --target ${STRATA_SANITIZE_TARGETS:-${tsan_targets[*]}}
-  ldd "$build/tests/integration/test_integration" | grep -q "$tbb_lib/libtbb.so.12" \
-    || { echo "sanitize.sh: the tests do not load the TSan libtbb in $tbb_lib" >&2; exit 1; }
+  # ldd's whole output first: `ldd | grep -q` under pipefail fails at random when grep exits on
+  # its match before ldd has written its last line (SIGPIPE), as one CI run did.
+  loads=$(ldd "$build/tests/integration/test_integration")
+  if [[ $loads != *"$tbb_lib/libtbb.so.12 "* ]]; then
+    echo "sanitize.sh: the tests do not load the TSan libtbb in $tbb_lib:" >&2
+    echo "$loads" >&2
+    exit 1
+  fi
   filter=(-R "$tsan_tests")
   export STRATA_SANITIZER=thread
 fi
