@@ -38,7 +38,7 @@ struct DiffArgs {
     std::string png;
     bool save = false;
     bool list = false;
-    double memory_budget_mb = store::TileReader::kDefaultBudgetBytes / 1e6;
+    double memory_budget_mb = 512.0;  // as export and walls: MB of 10^6 bytes
 };
 
 constexpr const char* kSideHelp =
