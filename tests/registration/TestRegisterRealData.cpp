@@ -38,9 +38,12 @@ constexpr double kMinRawMatched = 0.9;
 // rotation within it plus this (S-PTAM's roll and pitch: strata's gap exceeds the
 // disagreement by 0.036 deg at most).
 constexpr double kStereoSlackDeg = 0.07;
-// KITTI's ground truth is this far at least from the scans' optimum at frame 5 (measured
-// 0.75 m): the known problem of frames 0-14, held so the docs' figure stays true.
-constexpr double kGroundTruthOffAtFrame5M = 0.5;
+// How far KITTI's ground truth is from the scans' optimum at frame 5 (measured 0.75 m, 0.63 deg:
+// the known problem of frames 0-14), held within a factor of kGroundTruthOffFactor both ways so
+// the docs' figures stay true.
+constexpr double kGroundTruthOffAtFrame5M = 0.75;
+constexpr double kGroundTruthOffAtFrame5Deg = 0.63;
+constexpr double kGroundTruthOffFactor = 1.5;
 
 void Report(const std::string& what, const PoseGap& g) {
     ::testing::Test::RecordProperty(what + "_m", std::to_string(g.m));
@@ -93,7 +96,10 @@ TEST(RegistrationRealData, Kitti00FramesLandOnTheRawPointOptimumAndAmongTheStere
         if (j == 5) {
             const PoseGap gt = Gap(k.ground_truth[0].inverse() * k.ground_truth[5], opt.mean);
             Report("frame5_ground_truth_vs_raw", gt);
-            EXPECT_GT(gt.m, kGroundTruthOffAtFrame5M);
+            EXPECT_GT(gt.m, kGroundTruthOffAtFrame5M / kGroundTruthOffFactor);
+            EXPECT_LT(gt.m, kGroundTruthOffAtFrame5M * kGroundTruthOffFactor);
+            EXPECT_GT(gt.deg, kGroundTruthOffAtFrame5Deg / kGroundTruthOffFactor);
+            EXPECT_LT(gt.deg, kGroundTruthOffAtFrame5Deg * kGroundTruthOffFactor);
         }
     }
 }
