@@ -1,9 +1,12 @@
 #include "strata/pipeline/Walls.hpp"
 
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "WallsByTiles.hpp"
 #include "strata/pipeline/MapAccess.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::pipeline {
@@ -18,13 +21,27 @@ WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapsh
     config.Validate();
     // Whole when it fits: the same walls as tile by tile, without reading the halos again.
     if (!WallsReadWhole(map, snapshot, memory_budget_bytes)) {
-        return detail::FindWallsByTiles(map, snapshot, config, memory_budget_bytes);
+        return detail::FindWallsByTiles(map, snapshot, config, memory_budget_bytes, Ranks());
     }
     WallsOutcome outcome;
     outcome.map = map.LoadMap(snapshot);
     outcome.commit = snapshot.commit;
     outcome.result = walls::FindWalls(outcome.map, config);
     return outcome;
+}
+
+WallsOutcome FindWallsOnRanks(const store::MapStore& map, const store::Snapshot& snapshot,
+                              const walls::WallConfig& config, size_t memory_budget_bytes,
+                              const Ranks& ranks) {
+    if (ranks.size() == 1) return FindWalls(map, snapshot, config, memory_budget_bytes);
+    // Rank 0's snapshot on every rank, though another process commits meanwhile.
+    const int64_t commit = std::stoll(ranks.Broadcast(std::to_string(snapshot.commit)));
+    std::optional<store::Snapshot> same;
+    OnEveryRank(ranks, [&] {
+        config.Validate();
+        same = ranks.root() ? snapshot : map.At(commit);
+    });
+    return detail::FindWallsByTiles(map, *same, config, memory_budget_bytes, ranks);
 }
 
 std::string WallRow(const walls::Wall& w) {

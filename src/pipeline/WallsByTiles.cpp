@@ -6,19 +6,23 @@
 // the candidates are taken in the occupancy tree's order, the lowest voxels in raster order.
 #include "WallsByTiles.hpp"
 
+#include <openvdb/io/Stream.h>
 #include <openvdb/tools/Morphology.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "strata/core/Error.hpp"
 #include "strata/core/GridBox.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 #include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline::detail {
@@ -99,6 +103,109 @@ struct Kept {
     size_t occupied_columns = 0, voting_columns = 0;
 };
 
+// Kept over the ranks (docs/scale.md): a rank's Kept in bytes, and merged into rank 0's. The
+// ranks' candidates lie in their own tiles; what two ranks both kept (the occupancy near a
+// border) holds the same values, so the union does not depend on the order of the ranks.
+constexpr const char* kCandidatesGrid = "wall_candidates";
+
+template <typename T>
+void Put(std::string& out, const T& value) {
+    out.append(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+template <typename T>
+void PutVector(std::string& out, const std::vector<T>& values) {
+    Put(out, static_cast<uint64_t>(values.size()));
+    out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+}
+class Reader {
+public:
+    explicit Reader(const std::string& bytes) : bytes_(bytes) {}
+    template <typename T>
+    T Get() {
+        T value;
+        Take(&value, sizeof(T));
+        return value;
+    }
+    template <typename T>
+    std::vector<T> GetVector() {
+        std::vector<T> values(Get<uint64_t>());
+        Take(values.data(), values.size() * sizeof(T));
+        return values;
+    }
+    [[nodiscard]] std::string Rest() const { return bytes_.substr(at_); }
+
+private:
+    void Take(void* to, size_t n) {
+        if (at_ + n > bytes_.size()) throw FormatError("walls: a rank's answer is cut short");
+        std::memcpy(to, bytes_.data() + at_, n);
+        at_ += n;
+    }
+    const std::string& bytes_;
+    size_t at_ = 0;
+};
+
+std::string Encode(const Kept& k) {
+    std::string out;
+    Put(out, k.occupied_columns);
+    Put(out, k.voting_columns);
+    Put(out, k.occupied.min());
+    Put(out, k.occupied.max());
+    PutVector(out, k.lowest);
+    PutVector(out, k.voting_empty);
+    openvdb::GridPtrVec grids = k.map.Grids();
+    k.candidates->setName(kCandidatesGrid);
+    grids.push_back(k.candidates);
+    std::ostringstream os(std::ios_base::binary);
+    openvdb::io::Stream(os).write(grids);
+    return out + os.str();
+}
+
+// Copies every voxel `from` holds (active, or inactive with a value of its own) into `into`.
+template <typename GridT>
+void MergeVoxels(const GridT& from, GridT& into) {
+    const auto background = from.background();
+    auto acc = into.getAccessor();
+    for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {
+        for (auto v = leaf->cbeginValueAll(); v; ++v) {
+            if (v.isValueOn()) {
+                acc.setValueOn(v.getCoord(), *v);
+            } else if (*v != background) {
+                acc.setValueOff(v.getCoord(), *v);
+            }
+        }
+    }
+    for (auto it = from.tree().cbeginValueOn(); it; ++it) {
+        if (!it.isVoxelValue()) into.tree().fill(it.getBoundingBox(), *it, true);
+    }
+}
+
+void Merge(const std::string& bytes, Kept& into) {
+    Reader in(bytes);
+    into.occupied_columns += in.Get<size_t>();
+    into.voting_columns += in.Get<size_t>();
+    const Coord lo = in.Get<Coord>(), hi = in.Get<Coord>();
+    if (!CoordBBox(lo, hi).empty()) {
+        into.occupied.expand(lo);
+        into.occupied.expand(hi);
+    }
+    for (const Kept::Lowest& l : in.GetVector<Kept::Lowest>()) into.lowest.push_back(l);
+    for (const auto& e : in.GetVector<std::pair<int32_t, int32_t>>()) {
+        into.voting_empty.push_back(e);
+    }
+    std::istringstream is(in.Rest(), std::ios_base::binary);
+    openvdb::io::Stream stream(is, /*delayLoad=*/false);
+    openvdb::GridPtrVec grids = *stream.getGrids();
+    const auto candidates = std::find_if(
+        grids.begin(), grids.end(), [](const auto& g) { return g->getName() == kCandidatesGrid; });
+    if (candidates == grids.end()) throw FormatError("walls: a rank's answer has no candidates");
+    MergeVoxels(*openvdb::gridPtrCast<openvdb::BoolGrid>(*candidates), *into.candidates);
+    grids.erase(candidates);
+    const core::VoxelMap map = core::VoxelMap::FromGrids(grids);
+    MergeVoxels(*map.occupancy, *into.map.occupancy);
+    MergeVoxels(*map.label, *into.map.label);
+    MergeVoxels(*map.endpoints, *into.map.endpoints);
+}
+
 class Groups {
 public:
     Groups(const store::Snapshot& snapshot, int halo) : halo_(halo) {
@@ -143,6 +250,8 @@ public:
         if (!current.empty()) groups.push_back(std::move(current));
         return groups;
     }
+
+    [[nodiscard]] const std::map<TileKey, uint64_t>& bytes() const { return bytes_; }
 
     [[nodiscard]] uint64_t Bytes(const TileKey& k) const {
         const auto it = bytes_.find(k);
@@ -242,10 +351,24 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
     }
 }
 
+// The budget groups are split by: on several ranks at most an even share of the map (so that
+// every rank gets groups), never less than the largest tile with its halo.
+size_t ShareOfRank(const Groups& groups, size_t budget, int ranks) {
+    if (ranks <= 1) return budget;
+    uint64_t total = 0, largest = 0;
+    for (const auto& [key, bytes] : groups.bytes()) {
+        total += bytes;
+        largest = std::max(largest, groups.Cost({key}));
+    }
+    const uint64_t share = std::max<uint64_t>(total / static_cast<uint64_t>(ranks), largest);
+    return budget == 0 ? share : std::min<size_t>(budget, share);
+}
+
 }  // namespace
 
 WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
-                              const walls::WallConfig& config, size_t memory_budget_bytes) {
+                              const walls::WallConfig& config, size_t memory_budget_bytes,
+                              const Ranks& ranks) {
     config.Validate();
     const auto start = std::chrono::steady_clock::now();
     const store::MapSettings& settings = map.settings();
@@ -256,13 +379,28 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     }
     const Groups groups(snapshot, halo);
     const std::vector<std::vector<TileKey>> split =
-        groups.Split(memory_budget_bytes, map.dir().string());
+        groups.Split(ShareOfRank(groups, memory_budget_bytes, ranks.size()), map.dir().string());
     // Nothing cached: each group is read, voted on and dropped.
     const store::TileReader reader(map, snapshot, 0);
     Kept kept;
     kept.map = map.EmptyMap();
-    for (const std::vector<TileKey>& group : split) {
-        CollectGroup(reader, settings, group, groups, halo, config, kept);
+    size_t mine = 0;
+    OnEveryRank(ranks, [&] {
+        for (size_t g = static_cast<size_t>(ranks.rank()); g < split.size();
+             g += static_cast<size_t>(ranks.size())) {
+            CollectGroup(reader, settings, split[g], groups, halo, config, kept);
+            ++mine;
+        }
+    });
+    if (ranks.size() > 1) {
+        const std::vector<std::string> all = ranks.Gather(ranks.root() ? "" : Encode(kept));
+        if (!ranks.root()) {
+            WallsOutcome outcome;
+            outcome.commit = snapshot.commit;
+            outcome.tile_groups = mine;
+            return outcome;
+        }
+        for (size_t r = 1; r < all.size(); ++r) Merge(all[r], kept);
     }
 
     walls::WallResult voted;

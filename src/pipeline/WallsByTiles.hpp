@@ -3,6 +3,7 @@
 
 #include <cstddef>
 
+#include "strata/pipeline/Ranks.hpp"
 #include "strata/pipeline/Walls.hpp"
 
 namespace strata::pipeline::detail {
@@ -11,10 +12,13 @@ namespace strata::pipeline::detail {
 /// largest neighbour read for their halo) stay within `memory_budget_bytes` on disk. Equal to
 /// walls::FindWalls on the loaded snapshot; `map` of the outcome holds only what the stages
 /// after voting read (the candidates and the occupancy within reach of them).
+/// On several `ranks` (every rank calls it with the same snapshot), rank r reads the groups
+/// r, r + N, ... and rank 0 joins what they kept and runs the stages after voting: it gets the
+/// walls, bit for bit those of one process; the other ranks get an outcome without walls.
 /// @throw RefusedError naming --memory-budget when one tile and its halo exceed the budget.
 [[nodiscard]] WallsOutcome FindWallsByTiles(const store::MapStore& map,
                                             const store::Snapshot& snapshot,
                                             const walls::WallConfig& config,
-                                            size_t memory_budget_bytes);
+                                            size_t memory_budget_bytes, const Ranks& ranks);
 
 }  // namespace strata::pipeline::detail

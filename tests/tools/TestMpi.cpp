@@ -1,9 +1,10 @@
-// `mpirun -n N strata integrate ...` end to end (docs/scale.md): the map one process makes, and
-// a rank killed mid-run leaves the map at its last commit.
+// `mpirun -n N strata integrate ...` and `strata walls` end to end (docs/scale.md): the map and
+// the walls one process makes, and a rank killed mid-run leaves the map at its last commit.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -65,6 +66,51 @@ TEST(MpiCli, IntegrateOnTwoAndThreeRanksGivesTheOneProcessMap) {
     const Result info = Mpirun(2, "info " + one.string());
     EXPECT_EQ(info.code, 0) << info.out;
     EXPECT_EQ(Count(info.out, "\nsessions:\n"), 1u) << info.out;
+}
+
+TEST(MpiCli, WallsOnTwoAndThreeRanksAreTheOneProcessWalls) {
+    SequenceSpec spec;
+    spec.scans = 5;
+    spec.room_half_m = Eigen::Vector3d(6.0, 4.0, 3.0);  // walls 6 m high
+    const fs::path seq = MakeSequence(Temp("mpi_walls_seq"), spec);
+    const fs::path map = Temp("mpi_walls_map");
+    // Tiles of 3.2 m: every wall of the room crosses tile borders.
+    ASSERT_EQ(Strata("integrate " + map.string() + " --kitti " + seq.string() +
+                     " --voxel 0.1 --tile-size 3.2")
+                  .code,
+              0);
+    const fs::path out = Temp("mpi_walls_out");
+    fs::create_directories(out);
+    const Result one = Strata("walls " + map.string() + " --no-save --memory-budget 0 --csv " +
+                              (out / "one.csv").string());
+    ASSERT_EQ(one.code, 0) << one.out;
+    const std::string csv = ReadText(out / "one.csv");
+    EXPECT_GE(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;  // the header, 2+ walls
+    for (int ranks : {2, 3}) {
+        const fs::path csv_n = out / ("ranks" + std::to_string(ranks) + ".csv");
+        // Three ranks also store the walls: rank 0 alone commits them.
+        const std::string save = ranks == 2 ? " --no-save" : "";
+        const Result r = Mpirun(
+            ranks, "walls " + map.string() + save + " --memory-budget 0 --csv " + csv_n.string());
+        ASSERT_EQ(r.code, 0) << r.out;
+        EXPECT_EQ(Count(r.out, " walls from "), 1u) << r.out;  // rank 0 reports, once
+        EXPECT_NE(r.out.find("over " + std::to_string(ranks) + " ranks"), std::string::npos)
+            << r.out;
+        EXPECT_EQ(ReadText(csv_n), csv) << ranks << " ranks";
+    }
+    const Result check = Strata("check " + map.string());
+    EXPECT_EQ(check.code, 0) << check.out;
+    const Result again =
+        Strata("walls " + map.string() + " --no-save --csv " + (out / "after.csv").string());
+    EXPECT_EQ(again.code, 0) << again.out;
+    EXPECT_EQ(ReadText(out / "after.csv"), csv);
+    // Pictures of the whole map are refused on several ranks; the map stays as it was.
+    const auto before = MapFiles(map);
+    const Result png = Mpirun(2, "walls " + map.string() + " --png " + (out / "w.png").string());
+    EXPECT_NE(png.code, 0) << png.out;
+    EXPECT_NE(png.out.find("run them in one process"), std::string::npos) << png.out;
+    EXPECT_FALSE(fs::exists(out / "w.png"));
+    EXPECT_EQ(MapFiles(map), before);
 }
 
 // The pid of the process of rank `rank` running `strata integrate` on `map`, or -1.

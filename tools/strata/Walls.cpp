@@ -6,12 +6,14 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
 #include "strata/columns/ColumnPicture.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::tools {
@@ -52,8 +54,9 @@ void PrintSummary(const pipeline::WallsOutcome& outcome, const store::MapStore& 
     std::cout << "\n";
     if (outcome.tile_groups > 0) {
         std::cout << "read tile by tile within --memory-budget: " << outcome.tile_groups
-                  << " groups of tiles, " << outcome.kept_bytes / 1000000.0
-                  << " MB kept across them\n";
+                  << " groups of tiles";
+        if (CommandRanks().size() > 1) std::cout << " over " << CommandRanks().size() << " ranks";
+        std::cout << ", " << outcome.kept_bytes / 1000000.0 << " MB kept across them\n";
     }
     std::cout << "   id   slant deg  +-1 sigma  lean az  length m  height m  inliers  rms m   "
                  "centroid (map frame)\n";
@@ -71,23 +74,39 @@ void Run(const WallsArgs& args) {
     args.config.Validate();
     // Products go into the map: open as the writer up front, so a busy map fails before work.
     const bool save = !args.no_save && args.as_of.empty();
-    store::MapStore map =
-        OpenMap(args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    const store::Snapshot snapshot = SelectSnapshot(map, args.as_of);
+    // Under mpirun every rank reads its share of the tiles; rank 0 joins them, reports and saves.
+    const pipeline::Ranks& ranks = CommandRanks();
+    store::MapStore map = pipeline::OpenOnRanks(args.map, ranks, [&] {
+        return OpenMap(args.map,
+                       save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
+    });
+    std::optional<store::Snapshot> snapshot;
+    pipeline::OnEveryRank(ranks, [&] {
+        if (ranks.root()) snapshot = SelectSnapshot(map, args.as_of);
+    });
     const auto budget = static_cast<size_t>(args.memory_budget_mb * 1e6);
     // The slant picture and the column statistics cover the whole map: read tile by tile, only
     // the voxels near wall candidates are kept, so they are refused rather than drawn partly.
     const bool whole_map_outputs = !args.png.empty() || !args.columns_csv.empty() ||
                                    !args.columns_png.empty() || !args.columns_vdb.empty();
-    if (whole_map_outputs && !pipeline::WallsReadWhole(map, snapshot, budget)) {
+    pipeline::OnEveryRank(ranks, [&] {
+        if (!ranks.root() || !whole_map_outputs) return;
+        if (ranks.size() > 1) {
+            throw RefusedError(map.dir().string() +
+                               ": --png and --columns-* draw the whole map, which the ranks of "
+                               "mpirun read only in parts; run them in one process");
+        }
+        if (pipeline::WallsReadWhole(map, *snapshot, budget)) return;
         std::ostringstream mb;
         mb << args.memory_budget_mb;
         throw RefusedError(map.dir().string() + ": --png and --columns-* draw the whole map, " +
                            "which exceeds --memory-budget " + mb.str() +
                            " MB; raise --memory-budget (0: no limit) or leave them out (the " +
                            "walls, --csv, --vdb and --json are found tile by tile)");
-    }
-    const pipeline::WallsOutcome outcome = pipeline::FindWalls(map, snapshot, args.config, budget);
+    });
+    const pipeline::WallsOutcome outcome = pipeline::FindWallsOnRanks(
+        map, snapshot ? *snapshot : store::Snapshot{}, args.config, budget, ranks);
+    if (!ranks.root()) return;
     const core::VoxelMap& voxels = outcome.map;
     const walls::WallResult& result = outcome.result;
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "strata/pipeline/Ranks.hpp"
 #include "strata/store/MapStore.hpp"
 #include "strata/walls/Walls.hpp"
 
@@ -31,6 +32,16 @@ struct WallsOutcome {
 [[nodiscard]] WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
                                      const walls::WallConfig& config,
                                      size_t memory_budget_bytes = size_t{512} << 20);
+
+/// @brief FindWalls on the ranks of mpirun (docs/scale.md), each rank reading its share of the
+/// groups of tiles of the snapshot rank 0 passes (the others' `snapshot` is not read): rank 0
+/// gets the walls, bit for bit those of one process, and the other ranks an outcome without
+/// walls. On one rank, FindWalls. Every rank must call it.
+/// @throw what FindWalls throws, on every rank ("rank K: ..." when another rank's).
+[[nodiscard]] WallsOutcome FindWallsOnRanks(const store::MapStore& map,
+                                            const store::Snapshot& snapshot,
+                                            const walls::WallConfig& config,
+                                            size_t memory_budget_bytes, const Ranks& ranks);
 
 /// @brief Whether FindWalls loads the snapshot whole under this budget (outputs drawing the
 /// whole map, such as the slant map, need it).
