@@ -13,7 +13,10 @@ namespace strata::pipeline {
 
 bool WallsReadWhole(const store::MapStore& map, const store::Snapshot& snapshot,
                     size_t memory_budget_bytes) {
-    return memory_budget_bytes == 0 || map.Bytes(snapshot).fused_current <= memory_budget_bytes;
+    if (memory_budget_bytes == 0) return true;
+    const double decoded = static_cast<double>(map.Bytes(snapshot).fused_current) *
+                           detail::MemoryPerFileByte(map, snapshot);
+    return decoded <= static_cast<double>(memory_budget_bytes);
 }
 
 WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -20,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/GridBox.hpp"
 #include "strata/pipeline/RankedSession.hpp"
@@ -91,11 +93,16 @@ void CopyValue(const FromT& from, IntoT& into, const Coord& c) {
 
 // What the groups leave for the stages after voting, and stage 1's counts.
 struct Kept {
-    core::VoxelMap map;
+    core::VoxelMap map;  ///< the candidates' endpoints and labels (no occupancy)
     openvdb::BoolGrid::Ptr candidates = openvdb::BoolGrid::create(false);
+    /// The voxels seen free within walls::kObservedSideReachVoxels of a candidate: all the later
+    /// stages read of the occupancy, in a BoolGrid's memory.
+    openvdb::BoolGrid::Ptr observed_free = openvdb::BoolGrid::create(false);
+    /// The lowest voxel of an occupied column and its packed endpoints (has_mean 0: none), the
+    /// mean computed for GroundSample's columns only: 20 bytes per column.
     struct Lowest {
-        int32_t j, i;
-        Eigen::Vector3d mean;
+        int32_t j, i, k;
+        int32_t packed, has_mean;
     };
     std::vector<Lowest> lowest;
     std::vector<std::pair<int32_t, int32_t>> voting_empty;  // voting columns with no voxel
@@ -107,6 +114,7 @@ struct Kept {
 // ranks' candidates lie in their own tiles; what two ranks both kept (the occupancy near a
 // border) holds the same values, so the union does not depend on the order of the ranks.
 constexpr const char* kCandidatesGrid = "wall_candidates";
+constexpr const char* kObservedFreeGrid = "observed_free";
 
 template <typename T>
 void Put(std::string& out, const T& value) {
@@ -154,7 +162,9 @@ std::string Encode(const Kept& k) {
     PutVector(out, k.voting_empty);
     openvdb::GridPtrVec grids = k.map.Grids();
     k.candidates->setName(kCandidatesGrid);
+    k.observed_free->setName(kObservedFreeGrid);
     grids.push_back(k.candidates);
+    grids.push_back(k.observed_free);
     std::ostringstream os(std::ios_base::binary);
     openvdb::io::Stream(os).write(grids);
     return out + os.str();
@@ -195,24 +205,32 @@ void Merge(const std::string& bytes, Kept& into) {
     std::istringstream is(in.Rest(), std::ios_base::binary);
     openvdb::io::Stream stream(is, /*delayLoad=*/false);
     openvdb::GridPtrVec grids = *stream.getGrids();
-    const auto candidates = std::find_if(
-        grids.begin(), grids.end(), [](const auto& g) { return g->getName() == kCandidatesGrid; });
-    if (candidates == grids.end()) throw FormatError("walls: a rank's answer has no candidates");
-    MergeVoxels(*openvdb::gridPtrCast<openvdb::BoolGrid>(*candidates), *into.candidates);
-    grids.erase(candidates);
+    for (const auto& [name, to] : {std::pair{kCandidatesGrid, into.candidates},
+                                   std::pair{kObservedFreeGrid, into.observed_free}}) {
+        const auto it = std::find_if(grids.begin(), grids.end(),
+                                     [&](const auto& g) { return g->getName() == name; });
+        const auto grid =
+            it == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::BoolGrid>(*it);
+        if (!grid) throw FormatError(std::string("walls: a rank's answer has no ") + name);
+        MergeVoxels(*grid, *to);
+        grids.erase(it);
+    }
     const core::VoxelMap map = core::VoxelMap::FromGrids(grids);
-    MergeVoxels(*map.occupancy, *into.map.occupancy);
     MergeVoxels(*map.label, *into.map.label);
     MergeVoxels(*map.endpoints, *into.map.endpoints);
 }
 
 class Groups {
 public:
-    Groups(const store::Snapshot& snapshot, int halo) : halo_(halo) {
-        for (const store::TileVersion& t : snapshot.tiles) bytes_[t.key] = t.bytes;
+    Groups(const store::Snapshot& snapshot, int halo, double memory_per_file_byte) : halo_(halo) {
+        for (const store::TileVersion& t : snapshot.tiles) {
+            bytes_[t.key] = static_cast<uint64_t>(
+                std::ceil(static_cast<double>(t.bytes) * memory_per_file_byte));
+        }
     }
 
-    // Fused bytes a group reads at once: its tiles, and the largest neighbour cut to its halo.
+    // Memory a group takes at once (its fused files decoded): its tiles, and the largest
+    // neighbour read for its halo.
     [[nodiscard]] uint64_t Cost(const std::vector<TileKey>& group) const {
         const std::set<TileKey> in(group.begin(), group.end());
         uint64_t own = 0, neighbour = 0;
@@ -235,9 +253,9 @@ public:
             if (Cost({key}) > budget) {
                 throw RefusedError(
                     dir + ": tile " + std::to_string(key.x) + "_" + std::to_string(key.y) +
-                    " with its halo of " + std::to_string(halo_) + " voxels reads " +
+                    " with its halo of " + std::to_string(halo_) + " voxels takes about " +
                     Megabytes(static_cast<double>(Cost({key}))) +
-                    " of fused files, more than the memory budget of " +
+                    " in memory, more than the memory budget of " +
                     Megabytes(static_cast<double>(budget)) + "; raise --memory-budget");
             }
             current.push_back(key);
@@ -253,6 +271,7 @@ public:
 
     [[nodiscard]] const std::map<TileKey, uint64_t>& bytes() const { return bytes_; }
 
+    // A tile's memory once decoded (0 for a tile the snapshot does not have).
     [[nodiscard]] uint64_t Bytes(const TileKey& k) const {
         const auto it = bytes_.find(k);
         return it == bytes_.end() ? 0 : it->second;
@@ -260,7 +279,7 @@ public:
 
 private:
     int halo_;
-    std::map<TileKey, uint64_t> bytes_;
+    std::map<TileKey, uint64_t> bytes_;  // estimated memory per tile
 };
 
 // Stage 1 on one group of tiles read with its halo; its results go into `kept`.
@@ -299,6 +318,7 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
     const int radius = walls::WindowRadius(s, config);
     const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(g, core::GrownXY(box, halo));
     const columns::ColumnGrid window = cols.Window(radius);
+    const auto lowest_ends = g.endpoints->getConstAccessor();
     for (const TileKey& k : group) {
         const CoordBBox t = settings.TileBounds(k);
         for (int32_t j = t.min().y(); j <= t.max().y(); ++j) {
@@ -307,7 +327,9 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
                 if (c.voxels > 0) {
                     ++kept.occupied_columns;
                     kept.occupied.expand(Coord(i, j, 0));
-                    kept.lowest.push_back({j, i, g.PointMean(Coord(i, j, c.k_min))});
+                    int32_t packed = 0;
+                    const bool has_mean = lowest_ends.probeValue(Coord(i, j, c.k_min), packed);
+                    kept.lowest.push_back({j, i, c.k_min, packed, has_mean ? 1 : 0});
                 }
                 if (walls::WindowVotes(window.At(i, j), s, radius, config)) {
                     if (c.voxels > 0) {
@@ -341,12 +363,12 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
                                        openvdb::tools::NN_FACE_EDGE_VERTEX,
                                        openvdb::tools::EXPAND_TILES);
     const auto occupancy = g.occupancy->getConstAccessor();
-    auto kept_occupancy = kept.map.occupancy->getAccessor();
+    auto kept_free = kept.observed_free->getAccessor();
     for (auto it = mine->cbeginValueOn(); it; ++it) {
         const CoordBBox voxels = it.getBoundingBox();
         for (auto v = voxels.begin(); v; ++v) {
             float value = 0.0f;
-            if (occupancy.probeValue(*v, value)) kept_occupancy.setValueOn(*v, value);
+            if (occupancy.probeValue(*v, value) && value <= 0.0f) kept_free.setValueOn(*v, true);
         }
     }
 }
@@ -366,6 +388,16 @@ size_t ShareOfRank(const Groups& groups, size_t budget, int ranks) {
 
 }  // namespace
 
+double MemoryPerFileByte(const store::MapStore& map, const store::Snapshot& snapshot) {
+    const auto largest = std::max_element(
+        snapshot.tiles.begin(), snapshot.tiles.end(),
+        [](const store::TileVersion& a, const store::TileVersion& b) { return a.bytes < b.bytes; });
+    if (largest == snapshot.tiles.end() || largest->bytes == 0) return 1.0;
+    size_t memory = 0;
+    for (const auto& grid : map.ReadFused(*largest).Grids()) memory += grid->memUsage();
+    return std::max(1.0, static_cast<double>(memory) / static_cast<double>(largest->bytes));
+}
+
 WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                               const walls::WallConfig& config, size_t memory_budget_bytes,
                               const Ranks& ranks) {
@@ -377,7 +409,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
         throw InvalidArgumentError("walls: the halo (" + std::to_string(halo) +
                                    " voxels) must be smaller than a tile");
     }
-    const Groups groups(snapshot, halo);
+    const Groups groups(snapshot, halo, MemoryPerFileByte(map, snapshot));
     const std::vector<std::vector<TileKey>> split =
         groups.Split(ShareOfRank(groups, memory_budget_bytes, ranks.size()), map.dir().string());
     // Nothing cached: each group is read, voted on and dropped.
@@ -410,11 +442,21 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     for (const auto& [i, j] : kept.voting_empty) {
         voted.stats.voting_columns += kept.occupied.isInside(Coord(i, j, 0));
     }
+    size_t kept_bytes = kept.candidates->memUsage() + kept.observed_free->memUsage() +
+                        kept.lowest.capacity() * sizeof(Kept::Lowest) +
+                        kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
+    for (const auto& grid : kept.map.Grids()) kept_bytes += grid->memUsage();
     std::sort(kept.lowest.begin(), kept.lowest.end(),
               [](const auto& a, const auto& b) { return a.j != b.j ? a.j < b.j : a.i < b.i; });
+    // The means of the sample only, as VoxelMap::PointMean computes them.
     std::vector<Eigen::Vector3d> lowest;
-    lowest.reserve(kept.lowest.size());
-    for (const auto& l : kept.lowest) lowest.push_back(l.mean);
+    for (size_t n : walls::GroundSample(kept.lowest.size())) {
+        const Kept::Lowest& l = kept.lowest[n];
+        const Eigen::Vector3d centre = kept.map.VoxelCenter(Coord(l.i, l.j, l.k));
+        lowest.push_back(l.has_mean ? centre + core::endpoint::Offset(l.packed, kept.map.voxel_size)
+                                    : centre);
+    }
+    kept.lowest = {};
     voted.ground = walls::FitGround(std::move(lowest), settings.voxel_size_m, config.seed);
     // The occupancy tree's order, as VoteCandidates gives a whole map's candidates.
     std::vector<Coord> candidates;
@@ -428,11 +470,9 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     WallsOutcome outcome;
     outcome.commit = snapshot.commit;
     outcome.tile_groups = split.size();
-    for (const auto& grid : kept.map.Grids()) outcome.kept_bytes += grid->memUsage();
-    outcome.kept_bytes += kept.candidates->memUsage() +
-                          kept.lowest.capacity() * sizeof(Kept::Lowest) +
-                          kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
-    outcome.result = walls::FindWallsAmong(kept.map, candidates, std::move(voted), config);
+    outcome.kept_bytes = kept_bytes;
+    outcome.result = walls::FindWallsAmong(kept.map, candidates, std::move(voted), config,
+                                           kept.observed_free.get());
     outcome.map = std::move(kept.map);
     return outcome;
 }

@@ -8,8 +8,13 @@
 
 namespace strata::pipeline::detail {
 
-/// @brief The walls of the whole snapshot, reading groups of tiles whose fused files (and the
-/// largest neighbour read for their halo) stay within `memory_budget_bytes` on disk. Equal to
+/// @brief Memory per byte of fused file once a tile is decoded (at least 1), measured on the
+/// snapshot's largest tile: the same on every rank. Budgets count memory, files are compressed.
+[[nodiscard]] double MemoryPerFileByte(const store::MapStore& map, const store::Snapshot& snapshot);
+
+/// @brief The walls of the whole snapshot, reading groups of tiles whose decoded grids (and the
+/// largest neighbour read for their halo) stay within `memory_budget_bytes` (MemoryPerFileByte
+/// times their fused files). Equal to
 /// walls::FindWalls on the loaded snapshot; `map` of the outcome holds only what the stages
 /// after voting read (the candidates and the occupancy within reach of them).
 /// On several `ranks` (every rank calls it with the same snapshot), rank r reads the groups

@@ -22,13 +22,17 @@ double BoxGap(const Piece& a, const Piece& b) {
 // Orients a wall normal towards the side the scanner saw: of the voxels two voxels in front of
 // and behind a sample of inliers, the side with more observed-free voxels is the front.
 Eigen::Vector3d TowardsObservedSide(const core::VoxelMap& map,
+                                    const openvdb::BoolGrid* observed_free,
                                     const std::vector<openvdb::Coord>& voxels,
                                     const Eigen::Vector3d& normal) {
     auto occupancy = map.occupancy->getConstAccessor();
+    const openvdb::BoolGrid::Ptr none = observed_free ? nullptr : openvdb::BoolGrid::create(false);
+    auto seen_free = (observed_free ? *observed_free : *none).getConstAccessor();
     const size_t step = std::max<size_t>(1, voxels.size() / 256);
     int front = 0, back = 0;
     auto free_at = [&](const Eigen::Vector3d& p) {
         const openvdb::Coord c = map.WorldToVoxel(p);
+        if (observed_free) return seen_free.isValueOn(c);
         float value = 0.0f;
         return occupancy.probeValue(c, value) && value <= 0.0f;
     };

@@ -41,8 +41,10 @@ struct UnionFind {
 };
 
 // Orients a wall normal towards the side the scanner saw: of the voxels two voxels in front of
-// and behind a sample of inliers, the side with more observed-free voxels is the front.
+// and behind a sample of inliers, the side with more observed-free voxels is the front. A voxel
+// is observed free where `observed_free` is on, or without it, where the occupancy is <= 0.
 [[nodiscard]] Eigen::Vector3d TowardsObservedSide(const core::VoxelMap& map,
+                                                  const openvdb::BoolGrid* observed_free,
                                                   const std::vector<openvdb::Coord>& voxels,
                                                   const Eigen::Vector3d& normal);
 

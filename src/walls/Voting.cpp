@@ -73,17 +73,28 @@ GroundPlane EstimateGround(const core::VoxelMap& map, const columns::ColumnGrid&
     return FitGround(std::move(lowest), map.voxel_size, seed);
 }
 
-GroundPlane FitGround(std::vector<Eigen::Vector3d> lowest, double voxel_size, uint64_t seed) {
+std::vector<size_t> GroundSample(size_t columns) {
     constexpr size_t kMaxColumns = 50000;  // a sample is plenty for one plane
+    std::vector<size_t> sample;
+    const size_t n = std::min(columns, kMaxColumns);
+    const double step = static_cast<double>(columns) / static_cast<double>(n);
+    sample.reserve(n);
+    for (size_t k = 0; k < n; ++k) {
+        sample.push_back(columns > kMaxColumns ? static_cast<size_t>(static_cast<double>(k) * step)
+                                               : k);
+    }
+    return sample;
+}
+
+GroundPlane FitGround(std::vector<Eigen::Vector3d> lowest, double voxel_size, uint64_t seed) {
     GroundPlane ground;
     if (lowest.size() < 3) return ground;
-    if (lowest.size() > kMaxColumns) {
-        std::vector<Eigen::Vector3d> sample;
-        const double step = static_cast<double>(lowest.size()) / kMaxColumns;
-        for (size_t k = 0; k < kMaxColumns; ++k) {
-            sample.push_back(lowest[static_cast<size_t>(static_cast<double>(k) * step)]);
-        }
-        lowest.swap(sample);
+    const std::vector<size_t> sample = GroundSample(lowest.size());
+    if (sample.size() < lowest.size()) {
+        std::vector<Eigen::Vector3d> points;
+        points.reserve(sample.size());
+        for (size_t k : sample) points.push_back(lowest[k]);
+        lowest.swap(points);
     }
     const RansacResult r = RansacPlane(lowest, voxel_size, 200, seed);
     ground.normal = r.plane.normal.z() < 0.0 ? Eigen::Vector3d(-r.plane.normal) : r.plane.normal;

@@ -101,8 +101,10 @@ namespace {
 // The stages after voting, sharing the map, the settings and the result being filled.
 class Pipeline {
 public:
-    Pipeline(const core::VoxelMap& map, const WallConfig& config, WallResult& result)
+    Pipeline(const core::VoxelMap& map, const openvdb::BoolGrid* observed_free,
+             const WallConfig& config, WallResult& result)
         : map_(map),
+          observed_free_(observed_free),
           config_(config),
           result_(result),
           s_(map.voxel_size),
@@ -274,7 +276,7 @@ public:
         for (const auto& p : inliers) sum2 += plane.Distance(p) * plane.Distance(p);
         fit.plane = plane;
         fit.rms = std::sqrt(sum2 / static_cast<double>(inliers.size()));
-        wall.normal = TowardsObservedSide(map_, wall.voxels, plane.normal);
+        wall.normal = TowardsObservedSide(map_, observed_free_, wall.voxels, plane.normal);
         wall.d = wall.normal.dot(plane.normal) > 0 ? plane.d : -plane.d;
         wall.centroid = fit.centroid;
         wall.inliers = inliers.size();
@@ -308,6 +310,7 @@ public:
 
 private:
     const core::VoxelMap& map_;
+    const openvdb::BoolGrid* observed_free_;  // null: the occupancy says what was seen free
     const WallConfig& config_;
     WallResult& result_;
     double s_;
@@ -336,7 +339,8 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
 }
 
 WallResult FindWallsAmong(const core::VoxelMap& map, const std::vector<openvdb::Coord>& candidates,
-                          WallResult voted, const WallConfig& config) {
+                          WallResult voted, const WallConfig& config,
+                          const openvdb::BoolGrid* observed_free) {
     config.Validate();
     if (!map.occupancy) throw InvalidArgumentError("walls: the map has no occupancy grid");
     WallResult result = std::move(voted);
@@ -346,7 +350,7 @@ WallResult FindWallsAmong(const core::VoxelMap& map, const std::vector<openvdb::
     result.up = config.level_to_ground ? result.ground.normal : Eigen::Vector3d::UnitZ();
     result.stats.candidate_voxels = candidates.size();
     result.stats.clusters = result.stats.noise_voxels = 0;
-    Pipeline pipeline(map, config, result);
+    Pipeline pipeline(map, observed_free, config, result);
 
     // 2. DBSCAN, then K-means inside each cluster.
     auto t = Clock::now();

@@ -59,9 +59,14 @@ TEST(WallsByTiles, TileByTileFindsTheWholeMapsWalls) {
     }
     EXPECT_GE(crossing, 3u);
 
-    // A budget of a few tiles: many groups.
+    // A budget of a few decoded tiles (budgets count memory; tile files are compressed): many
+    // groups.
     uint64_t largest = 0;
-    for (const store::TileVersion& t : snapshot.tiles) largest = std::max(largest, t.bytes);
+    for (const store::TileVersion& t : snapshot.tiles) {
+        uint64_t memory = 0;
+        for (const auto& grid : map.ReadFused(t).Grids()) memory += grid->memUsage();
+        largest = std::max(largest, memory);
+    }
     const WallsOutcome tiled = FindWalls(map, snapshot, config, 6 * largest);
     EXPECT_GT(tiled.tile_groups, 3u);
     EXPECT_LT(tiled.tile_groups, snapshot.tiles.size());

@@ -14,8 +14,8 @@ namespace strata::pipeline {
 
 /// @brief The snapshot analysed and the walls found in it.
 struct WallsOutcome {
-    /// The snapshot's fused map when read whole; tile by tile, only the voxels the stages after
-    /// voting read (the candidates, the occupancy within reach of them).
+    /// The snapshot's fused map when read whole; tile by tile, only the candidates' endpoints
+    /// and labels (no occupancy).
     core::VoxelMap map;
     walls::WallResult result;
     int64_t commit = 0;      ///< the snapshot's commit
@@ -23,9 +23,9 @@ struct WallsOutcome {
     size_t kept_bytes = 0;   ///< tile by tile: memory of what was kept across groups
 };
 
-/// @brief Finds the walls of the snapshot (walls::FindWalls). A snapshot whose fused files fit
-/// `memory_budget_bytes` (0: no limit) is loaded whole; a larger one is read a group of tiles
-/// at a time, each with a halo of walls::HaloVoxels, and gives the same walls (docs/walls.md,
+/// @brief Finds the walls of the snapshot (walls::FindWalls). A snapshot whose decoded tiles fit
+/// `memory_budget_bytes` (0: no limit; estimated from the largest tile's memory per file byte)
+/// is loaded whole; a larger one is read a group of tiles at a time, each with a halo of walls::HaloVoxels, and gives the same walls (docs/walls.md,
 /// "Tile by tile"). The map is only read.
 /// @throw InvalidArgumentError for an invalid config; RefusedError naming --memory-budget when
 /// one tile and its halo exceed the budget; the store's errors.

@@ -169,6 +169,11 @@ inline constexpr int kObservedSideReachVoxels = 3;
 [[nodiscard]] GroundPlane FitGround(std::vector<Eigen::Vector3d> lowest, double voxel_size,
                                     uint64_t seed = 1);
 
+/// @brief Which of `columns` lowest voxels FitGround fits the plane to (all up to 50,000, else an
+/// even sample of 50,000), in order: FitGround of exactly these gives the same plane, so a map
+/// read in parts need only keep the columns' keys and compute the means of the sample.
+[[nodiscard]] std::vector<size_t> GroundSample(size_t columns);
+
 /// @brief Stage 1 (voting): the occupied voxels of the columns whose window votes for walls,
 /// minus the ground at the bottom of the window. `window` is columns.Window(radius).
 [[nodiscard]] std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
@@ -187,9 +192,12 @@ inline constexpr int kObservedSideReachVoxels = 3;
 /// stage 1's ground and counts. `map` needs the endpoints and labels of the candidates and the
 /// occupancy within HaloVoxels of them, nothing else: FindWalls(map) is
 /// FindWallsAmong(map, VoteCandidates(...), ...), and a map read tile by tile gives the same
-/// walls from only those voxels (pipeline::FindWalls).
+/// walls from only those voxels (pipeline::FindWalls). Only whether a voxel was seen free
+/// (occupancy <= 0) is read of the occupancy: `observed_free`, when given, holds those voxels
+/// (a sixteenth of a FloatGrid's memory) and the occupancy is not read.
 [[nodiscard]] WallResult FindWallsAmong(const core::VoxelMap& map,
                                         const std::vector<openvdb::Coord>& candidates,
-                                        WallResult voted, const WallConfig& config);
+                                        WallResult voted, const WallConfig& config,
+                                        const openvdb::BoolGrid* observed_free = nullptr);
 
 }  // namespace strata::walls
