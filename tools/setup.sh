@@ -2,16 +2,19 @@
 # Installs strata's build dependencies from Debian 12 packages (idempotent; run as root or with sudo).
 # Usage: tools/setup.sh                install only
 #        tools/setup.sh --build        install, then build the `strata` program into build/
+#        tools/setup.sh --python       install, then build the program and the Python module
 #        tools/setup.sh --sanitizers   install, and fetch the source of libtbb for
 #                                      tools/sanitize.sh tsan (.ci/run does)
 set -euo pipefail
 build=0
+python=0
 sanitizers=0
 for arg in "$@"; do
   case $arg in
     --build) build=1 ;;
+    --python) build=1 python=1 ;;
     --sanitizers) sanitizers=1 ;;
-    *) echo "usage: tools/setup.sh [--build] [--sanitizers]" >&2; exit 2 ;;
+    *) echo "usage: tools/setup.sh [--build] [--python] [--sanitizers]" >&2; exit 2 ;;
   esac
 done
 
@@ -102,13 +105,14 @@ if ((sanitizers)) && ! compgen -G "$tbb_source/onetbb_*.dsc" >/dev/null; then
   "${sudo_cmd[@]}" mv "$tbb_source.partial" "$tbb_source"
 fi
 
-# The `strata` program, the Python module (when configured: python/CMakeLists.txt) and what
-# they need, in build/ as tools/test.sh configures it (same settings, ccache), so the test
-# command afterwards compiles only the rest.
+# The `strata` program (with --python also the Python module, when configured:
+# python/CMakeLists.txt) and what they need, in build/ as tools/test.sh configures it (same
+# settings, ccache), so the test command afterwards compiles only the rest. The module is left
+# to --python and to the test command: the quick start's first picture does not wait for it.
 if ((build)); then
   root=$(cd "$(dirname "$0")/.." && pwd)
   "$root/tools/configure.sh"
   targets=(strata)
-  [[ -d $root/build/python/strata ]] && targets+=(_strata)
+  ((python)) && [[ -d $root/build/python/strata ]] && targets+=(_strata)
   cmake --build "$root/build" --target "${targets[@]}"
 fi

@@ -105,6 +105,21 @@ private:
 
 }  // namespace
 
+bool AllLeaves(const ScanUpdate& update, const LeafFilter& keep) {
+    for (const auto* tree : {update.free.get(), update.occupied.get()}) {
+        for (auto leaf = tree->cbeginLeaf(); leaf; ++leaf) {
+            if (!keep(leaf->origin())) return false;
+        }
+    }
+    openvdb::Coord last(std::numeric_limits<int32_t>::max());
+    for (const EndpointGroup& g : update.endpoints) {
+        const openvdb::Coord origin = LeafOrigin(g.ijk);
+        if (origin != last && !keep(origin)) return false;
+        last = origin;
+    }
+    return true;
+}
+
 ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep) {
     ScanUpdate part;
     part.free = SelectLeaves(*update.free, keep);

@@ -124,6 +124,7 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
             [&](size_t done) { ReportProgress(options.progress, stage, done, source->size()); });
         result.session = r.session;
         result.stats = r.stats;
+        result.steps = r.seconds;
         result.seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         result.map_tiles = map.Latest().tiles.size();

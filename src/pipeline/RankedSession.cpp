@@ -1,6 +1,7 @@
 #include "strata/pipeline/RankedSession.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <exception>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,21 @@ namespace strata::pipeline {
 namespace {
 
 using nlohmann::json;
+
+// Adds the wall time of its scope to `total`.
+class Timed {
+public:
+    explicit Timed(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+    ~Timed() {
+        total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    }
+    Timed(const Timed&) = delete;
+    Timed& operator=(const Timed&) = delete;
+
+private:
+    double& total_;
+    std::chrono::steady_clock::time_point start_;
+};
 
 // The kinds of strata::Error by a one-letter tag, so that a rank's failure is rethrown as the
 // same kind on the others (the CLI maps kinds to exit codes).
@@ -193,7 +209,8 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
                                      const std::function<core::Scan(size_t)>& read,
                                      const integration::IntegrationConfig& config,
                                      store::SessionOptions options, const Ranks& ranks,
-                                     const std::function<void(size_t)>& progress) {
+                                     const std::function<void(size_t)>& progress,
+                                     size_t scans_per_block) {
     const int n = ranks.size();
     const int me = ranks.rank();
     if (n > 1)
@@ -209,50 +226,79 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
         if (!ranks.root()) writer = std::make_unique<store::SessionWriter>(map, config, options);
     });
 
-    for (size_t first = 0; first < scans; first += static_cast<size_t>(n)) {
-        const size_t round = std::min(scans - first, static_cast<size_t>(n));
+    RankedSessionResult::Seconds seconds;
+    // On several ranks, scans go in rounds: rank r casts the r-th block of up to
+    // `scans_per_block` consecutive scans of a round and cuts each update by tile owner; every
+    // rank then applies the round's parts in its tiles in scan order. Ranks wait for each other
+    // once per block rather than once per scan, whose costs vary. Rank 0 also gets each scan's
+    // record.
+    if (scans_per_block == 0) throw InvalidArgumentError("scans per block must be at least 1");
+    const size_t block = n == 1 ? 1 : scans_per_block;
+    const size_t per_round = block * static_cast<size_t>(n);
+    for (size_t first = 0; first < scans; first += per_round) {
+        const size_t end = std::min(scans, first + per_round);
+        const auto begin_of = [&](int r) {
+            return std::min(end, first + static_cast<size_t>(r) * block);
+        };
         if (n == 1) {
+            const Timed timed(seconds.cast);
             OnEveryRank(ranks, [&] { (void)writer->Integrate(read(first)); });
         } else {
-            // Rank r computes scan first + r and cuts its update by owner; every rank then
-            // applies the parts in its tiles in scan order. Rank 0 also gets each scan's record.
             std::vector<std::string> out(static_cast<size_t>(n));
             OnEveryRank(ranks, [&] {
-                if (static_cast<size_t>(me) >= round) return;
-                const core::Scan scan = read(first + static_cast<size_t>(me));
-                const integration::ScanUpdate update = writer->Compute(scan);
-                for (int d = 0; d < n; ++d) {
-                    std::string& m = out[static_cast<size_t>(d)];
-                    AppendPiece(m, integration::EncodeUpdate(integration::SelectUpdate(
-                                       update, [&](const openvdb::Coord& leaf) {
-                                           return TileOwner(map.settings().TileOf(leaf), n) == d;
-                                       })));
-                    if (d == 0) {
-                        AppendPiece(
-                            m, RecordJson(store::SessionWriter::RecordOf(scan, update)).dump());
+                const Timed timed(seconds.cast);
+                for (size_t i = begin_of(me); i < begin_of(me + 1); ++i) {
+                    const core::Scan scan = read(i);
+                    const integration::ScanUpdate update = writer->Compute(scan);
+                    for (int d = 0; d < n; ++d) {
+                        std::string& m = out[static_cast<size_t>(d)];
+                        AppendPiece(m, integration::EncodeUpdate(integration::SelectUpdate(
+                                           update, [&](const openvdb::Coord& leaf) {
+                                               return TileOwner(map.settings().TileOf(leaf), n) ==
+                                                      d;
+                                           })));
+                        if (d == 0) {
+                            AppendPiece(
+                                m, RecordJson(store::SessionWriter::RecordOf(scan, update)).dump());
+                        }
                     }
                 }
             });
-            const std::vector<std::string> in = ranks.Exchange(out);
+            std::vector<std::string> in;
+            {
+                const Timed timed(seconds.exchange);
+                in = ranks.Exchange(out);
+            }
             OnEveryRank(ranks, [&] {
-                for (size_t s = 0; s < round; ++s) {
-                    const std::string what = "rank " + std::to_string(s) + "'s update of scan " +
-                                             std::to_string(first + s);
+                const Timed timed(seconds.apply);
+                for (int r = 0; r < n; ++r) {
                     size_t at = 0;
-                    writer->Apply(integration::DecodeUpdate(NextPiece(in[s], at, what), what));
-                    if (ranks.root()) {
-                        writer->AddScan(RecordFrom(json::parse(NextPiece(in[s], at, what))));
+                    for (size_t i = begin_of(r); i < begin_of(r + 1); ++i) {
+                        const std::string what =
+                            "rank " + std::to_string(r) + "'s update of scan " + std::to_string(i);
+                        const std::string& message = in[static_cast<size_t>(r)];
+                        writer->Apply(
+                            integration::DecodeUpdate(NextPiece(message, at, what), what));
+                        if (ranks.root()) {
+                            writer->AddScan(RecordFrom(json::parse(NextPiece(message, at, what))));
+                        }
                     }
                 }
             });
         }
-        if (ranks.root() && progress) progress(first + round);
+        if (ranks.root() && progress) progress(end);
     }
 
     // Every worker's files synced and handed to rank 0, which commits them all at once.
+    const auto commit_start = std::chrono::steady_clock::now();
+    // Rank 0 writes its own files meanwhile: the commit then only records them.
     std::string files;
     OnEveryRank(ranks, [&] {
-        if (!ranks.root()) files = FilesText(writer->WriteFiles());
+        if (ranks.root()) {
+            writer->WriteOwnFiles();
+        } else {
+            files = FilesText(writer->WriteFiles());
+        }
     });
     const std::vector<std::string> all = ranks.Gather(files);
     RankedSessionResult result;
@@ -280,6 +326,9 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
         result.session.end_utc = s.at("end_utc").get<std::string>();
         result.stats = FilesFrom(session.at("stats").get<std::string>()).stats;
     }
+    seconds.commit =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - commit_start).count();
+    result.seconds = seconds;
     return result;
 }
 

@@ -67,6 +67,7 @@ struct SessionWriter::State {
     std::map<TileKey, Pending> pending;
     std::set<std::string> written_files;  // removed again unless the commit lands
     std::vector<ScanRecord> scans;
+    std::optional<SessionFiles> own_files;  // written ahead of the commit (WriteOwnFiles)
     size_t points = 0;
     uint64_t clock = 0;
     std::string start_utc;
@@ -337,12 +338,15 @@ integration::ScanUpdate SessionWriter::Compute(const core::Scan& scan) const {
 void SessionWriter::Apply(const integration::ScanUpdate& update) {
     State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
-    // A writer that keeps only some tiles applies only their part (updates act voxel by voxel).
+    if (s.own_files) throw InvalidArgumentError("the session's files are written already");
+    // A writer that keeps only some tiles applies only their part (updates act voxel by voxel);
+    // a part cut for it already (a rank's, docs/scale.md) is not copied again.
     std::optional<integration::ScanUpdate> part;
     if (s.options.owns) {
-        part = integration::SelectUpdate(update, [&](const openvdb::Coord& leaf) {
+        const integration::LeafFilter owned = [&](const openvdb::Coord& leaf) {
             return s.options.owns(s.settings().TileOf(leaf));
-        });
+        };
+        if (!integration::AllLeaves(update, owned)) part = integration::SelectUpdate(update, owned);
     }
     const integration::ScanUpdate& own = part ? *part : update;
     const std::set<TileKey> keys = s.TouchedTiles(own);
@@ -385,6 +389,13 @@ SessionFiles SessionWriter::WriteFiles() {
     return files;
 }
 
+void SessionWriter::WriteOwnFiles() {
+    State& s = *state_;
+    if (s.done || s.own_files)
+        throw InvalidArgumentError("the session's files are written already");
+    s.own_files = s.WriteOwnFiles();
+}
+
 SessionRecord SessionWriter::Commit(const std::vector<SessionFiles>& workers) {
     State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
@@ -399,7 +410,7 @@ SessionRecord SessionWriter::Commit(const std::vector<SessionFiles>& workers) {
         for (const TileVersion& v : w.versions) s.written_files.insert(v.file);
         for (const LayerFile& l : w.layers) s.written_files.insert(l.file);
     }
-    SessionFiles files = s.WriteOwnFiles();
+    SessionFiles files = s.own_files ? std::move(*s.own_files) : s.WriteOwnFiles();
     std::set<TileKey> tiles;
     for (const TileVersion& v : files.versions) tiles.insert(v.key);
     for (const SessionFiles& w : workers) {

@@ -82,6 +82,12 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
               << r.stats.tiles_written << " tile files (" << r.stats.bytes_written / 1e6
               << " MB), commit " << r.stats.commit_seconds << " s; map has " << r.map_tiles
               << " tiles\n";
+    if (CommandRanks().size() > 1) {
+        std::cout << "rank 0 of " << CommandRanks().size() << ": " << r.steps.cast
+                  << " s reading and casting its scans, " << r.steps.exchange
+                  << " s in the exchanges, " << r.steps.apply << " s applying its tiles' parts, "
+                  << r.steps.commit << " s writing and committing\n";
+    }
 }
 
 }  // namespace

@@ -22,6 +22,10 @@ using LeafFilter = std::function<bool(const openvdb::Coord& leaf_origin)>;
 /// whole update gives it (updates act voxel by voxel).
 [[nodiscard]] ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep);
 
+/// @brief Whether `keep` accepts every leaf of `update` (its free, occupied and endpoint voxels):
+/// then SelectUpdate would copy it whole.
+[[nodiscard]] bool AllLeaves(const ScanUpdate& update, const LeafFilter& keep);
+
 /// @brief The update as bytes (little-endian, versioned), to hand to another process.
 [[nodiscard]] std::string EncodeUpdate(const ScanUpdate& update);
 

@@ -9,6 +9,7 @@
 #include "strata/pipeline/Alignment.hpp"
 #include "strata/pipeline/OpenOrCreate.hpp"
 #include "strata/pipeline/Progress.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 #include "strata/pipeline/Ranks.hpp"
 #include "strata/pipeline/ScanSource.hpp"
 #include "strata/store/SessionWriter.hpp"
@@ -49,8 +50,9 @@ struct IntegrateOptions {
 struct IntegrateResult {
     store::SessionRecord session;
     store::WriterStats stats;
-    double seconds = 0.0;  ///< integrating and committing, not aligning
-    size_t map_tiles = 0;  ///< tiles of the map after the commit
+    double seconds = 0.0;                ///< integrating and committing, not aligning
+    RankedSessionResult::Seconds steps;  ///< where this rank's time went
+    size_t map_tiles = 0;                ///< tiles of the map after the commit
     bool created = false;
     std::optional<MapAlignment> alignment;
 };

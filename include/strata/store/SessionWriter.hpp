@@ -92,9 +92,14 @@ public:
     /// A worker's end: writes and syncs the files of its tiles and hands them to the committer
     /// (who owns them from here: they stay on disk if this writer is destroyed).
     [[nodiscard]] SessionFiles WriteFiles();
-    /// Writes this writer's files, then records them, the `workers`' files, the session and its
-    /// scans in one transaction; the writer cannot be used afterwards. If the commit fails, the
-    /// workers' files are removed with this writer's. A tile may have one writer only.
+    /// The committer's files written and synced now, while the workers write theirs (their
+    /// WriteFiles); Commit then records them. No scan may be applied afterwards; the files are
+    /// removed with the writer unless the commit lands.
+    void WriteOwnFiles();
+    /// Writes this writer's files (unless WriteOwnFiles did), then records them, the `workers`'
+    /// files, the session and its scans in one transaction; the writer cannot be used afterwards.
+    /// If the commit fails, the workers' files are removed with this writer's. A tile may have one
+    /// writer only.
     SessionRecord Commit(const std::vector<SessionFiles>& workers = {});
 
     [[nodiscard]] int64_t session_id() const;
