@@ -25,8 +25,9 @@ struct WallsOutcome {
 
 /// @brief Finds the walls of the snapshot (walls::FindWalls). A snapshot whose decoded tiles fit
 /// `memory_budget_bytes` (0: no limit; estimated from the largest tile's memory per file byte)
-/// is loaded whole; a larger one is read a group of tiles at a time, each with a halo of walls::HaloVoxels, and gives the same walls (docs/walls.md,
-/// "Tile by tile"). The map is only read.
+/// is loaded whole; a larger one is read a group of tiles at a time, each with a halo of
+/// walls::HaloVoxels, and gives the same walls (docs/walls.md, "Tile by tile"). The map is only
+/// read.
 /// @throw InvalidArgumentError for an invalid config; RefusedError naming --memory-budget when
 /// one tile and its halo exceed the budget; the store's errors.
 [[nodiscard]] WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
