@@ -205,8 +205,10 @@ void Merge(const std::string& bytes, Kept& into) {
     std::istringstream is(in.Rest(), std::ios_base::binary);
     openvdb::io::Stream stream(is, /*delayLoad=*/false);
     openvdb::GridPtrVec grids = *stream.getGrids();
-    for (const auto& [name, to] : {std::pair{kCandidatesGrid, into.candidates},
-                                   std::pair{kObservedFreeGrid, into.observed_free}}) {
+    for (const auto& [wanted, to] : {std::pair{kCandidatesGrid, into.candidates},
+                                     std::pair{kObservedFreeGrid, into.observed_free}}) {
+        // A structured binding cannot be captured before C++20 (clang refuses it).
+        const std::string name = wanted;
         const auto it = std::find_if(grids.begin(), grids.end(),
                                      [&](const auto& g) { return g->getName() == name; });
         const auto grid =

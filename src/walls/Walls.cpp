@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "Pieces.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/geometry/Clustering.hpp"
 #include "strata/geometry/PlaneFit.hpp"
