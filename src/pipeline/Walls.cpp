@@ -11,20 +11,33 @@
 
 namespace strata::pipeline {
 
+namespace {
+
+bool FitsWhole(const store::MapStore& map, const store::Snapshot& snapshot, size_t budget,
+               double memory_per_file_byte) {
+    return static_cast<double>(map.Bytes(snapshot).fused_current) * memory_per_file_byte <=
+           static_cast<double>(budget);
+}
+
+}  // namespace
+
 bool WallsReadWhole(const store::MapStore& map, const store::Snapshot& snapshot,
                     size_t memory_budget_bytes) {
-    if (memory_budget_bytes == 0) return true;
-    const double decoded = static_cast<double>(map.Bytes(snapshot).fused_current) *
-                           detail::MemoryPerFileByte(map, snapshot);
-    return decoded <= static_cast<double>(memory_budget_bytes);
+    return memory_budget_bytes == 0 ||
+           FitsWhole(map, snapshot, memory_budget_bytes, detail::MemoryPerFileByte(map, snapshot));
 }
 
 WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
                        const walls::WallConfig& config, size_t memory_budget_bytes) {
     config.Validate();
-    // Whole when it fits: the same walls as tile by tile, without reading the halos again.
-    if (!WallsReadWhole(map, snapshot, memory_budget_bytes)) {
-        return detail::FindWallsByTiles(map, snapshot, config, memory_budget_bytes, Ranks());
+    // Whole when it fits: the same walls as tile by tile, without reading the halos again. The
+    // largest tile is decoded once to measure memory per file byte.
+    if (memory_budget_bytes > 0) {
+        const double per_byte = detail::MemoryPerFileByte(map, snapshot);
+        if (!FitsWhole(map, snapshot, memory_budget_bytes, per_byte)) {
+            return detail::FindWallsByTiles(map, snapshot, config, memory_budget_bytes, per_byte,
+                                            Ranks());
+        }
     }
     WallsOutcome outcome;
     outcome.map = map.LoadMap(snapshot);
@@ -44,7 +57,8 @@ WallsOutcome FindWallsOnRanks(const store::MapStore& map, const store::Snapshot&
         config.Validate();
         same = ranks.root() ? snapshot : map.At(commit);
     });
-    return detail::FindWallsByTiles(map, *same, config, memory_budget_bytes, ranks);
+    return detail::FindWallsByTiles(map, *same, config, memory_budget_bytes,
+                                    detail::MemoryPerFileByte(map, *same), ranks);
 }
 
 std::string WallRow(const walls::Wall& w) {

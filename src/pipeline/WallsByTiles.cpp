@@ -402,7 +402,7 @@ double MemoryPerFileByte(const store::MapStore& map, const store::Snapshot& snap
 
 WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                               const walls::WallConfig& config, size_t memory_budget_bytes,
-                              const Ranks& ranks) {
+                              double memory_per_file_byte, const Ranks& ranks) {
     config.Validate();
     const auto start = std::chrono::steady_clock::now();
     const store::MapSettings& settings = map.settings();
@@ -411,7 +411,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
         throw InvalidArgumentError("walls: the halo (" + std::to_string(halo) +
                                    " voxels) must be smaller than a tile");
     }
-    const Groups groups(snapshot, halo, MemoryPerFileByte(map, snapshot));
+    const Groups groups(snapshot, halo, memory_per_file_byte);
     const std::vector<std::vector<TileKey>> split =
         groups.Split(ShareOfRank(groups, memory_budget_bytes, ranks.size()), map.dir().string());
     // Nothing cached: each group is read, voted on and dropped.
