@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "TileBudget.hpp"
 #include "WallsByTiles.hpp"
 #include "strata/pipeline/MapAccess.hpp"
 #include "strata/pipeline/RankedSession.hpp"
@@ -11,20 +12,10 @@
 
 namespace strata::pipeline {
 
-namespace {
-
-bool FitsWhole(const store::MapStore& map, const store::Snapshot& snapshot, size_t budget,
-               double memory_per_file_byte) {
-    return static_cast<double>(map.Bytes(snapshot).fused_current) * memory_per_file_byte <=
-           static_cast<double>(budget);
-}
-
-}  // namespace
-
 bool WallsReadWhole(const store::MapStore& map, const store::Snapshot& snapshot,
                     size_t memory_budget_bytes) {
-    return memory_budget_bytes == 0 ||
-           FitsWhole(map, snapshot, memory_budget_bytes, detail::MemoryPerFileByte(map, snapshot));
+    return memory_budget_bytes == 0 || detail::FitsWhole(map, snapshot, memory_budget_bytes,
+                                                         detail::MemoryPerFileByte(map, snapshot));
 }
 
 WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapshot,
@@ -34,7 +25,7 @@ WallsOutcome FindWalls(const store::MapStore& map, const store::Snapshot& snapsh
     // largest tile is decoded once to measure memory per file byte.
     if (memory_budget_bytes > 0) {
         const double per_byte = detail::MemoryPerFileByte(map, snapshot);
-        if (!FitsWhole(map, snapshot, memory_budget_bytes, per_byte)) {
+        if (!detail::FitsWhole(map, snapshot, memory_budget_bytes, per_byte)) {
             return detail::FindWallsByTiles(map, snapshot, config, memory_budget_bytes, per_byte,
                                             Ranks());
         }
@@ -50,15 +41,10 @@ WallsOutcome FindWallsOnRanks(const store::MapStore& map, const store::Snapshot&
                               const walls::WallConfig& config, size_t memory_budget_bytes,
                               const Ranks& ranks) {
     if (ranks.size() == 1) return FindWalls(map, snapshot, config, memory_budget_bytes);
-    // Rank 0's snapshot on every rank, though another process commits meanwhile.
-    const int64_t commit = std::stoll(ranks.Broadcast(std::to_string(snapshot.commit)));
-    std::optional<store::Snapshot> same;
-    OnEveryRank(ranks, [&] {
-        config.Validate();
-        same = ranks.root() ? snapshot : map.At(commit);
-    });
-    return detail::FindWallsByTiles(map, *same, config, memory_budget_bytes,
-                                    detail::MemoryPerFileByte(map, *same), ranks);
+    const store::Snapshot same = detail::SameSnapshotOnRanks(map, snapshot, ranks);
+    OnEveryRank(ranks, [&] { config.Validate(); });
+    return detail::FindWallsByTiles(map, same, config, memory_budget_bytes,
+                                    detail::MemoryPerFileByte(map, same), ranks);
 }
 
 std::string WallRow(const walls::Wall& w) {

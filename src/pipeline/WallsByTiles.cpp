@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include "Bytes.hpp"
+#include "TileBudget.hpp"
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/GridBox.hpp"
@@ -42,12 +44,6 @@ std::vector<TileKey> Around(const TileKey& k) {
         }
     }
     return keys;
-}
-
-std::string Megabytes(double bytes) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%.2f MB", bytes / 1e6);
-    return text;
 }
 
 // Adds the active voxels of `from` inside any of `boxes` to `into`, which holds no leaf where
@@ -116,42 +112,6 @@ struct Kept {
 constexpr const char* kCandidatesGrid = "wall_candidates";
 constexpr const char* kObservedFreeGrid = "observed_free";
 
-template <typename T>
-void Put(std::string& out, const T& value) {
-    out.append(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-template <typename T>
-void PutVector(std::string& out, const std::vector<T>& values) {
-    Put(out, static_cast<uint64_t>(values.size()));
-    out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-}
-class Reader {
-public:
-    explicit Reader(const std::string& bytes) : bytes_(bytes) {}
-    template <typename T>
-    T Get() {
-        T value;
-        Take(&value, sizeof(T));
-        return value;
-    }
-    template <typename T>
-    std::vector<T> GetVector() {
-        std::vector<T> values(Get<uint64_t>());
-        Take(values.data(), values.size() * sizeof(T));
-        return values;
-    }
-    [[nodiscard]] std::string Rest() const { return bytes_.substr(at_); }
-
-private:
-    void Take(void* to, size_t n) {
-        if (at_ + n > bytes_.size()) throw FormatError("walls: a rank's answer is cut short");
-        std::memcpy(to, bytes_.data() + at_, n);
-        at_ += n;
-    }
-    const std::string& bytes_;
-    size_t at_ = 0;
-};
-
 std::string Encode(const Kept& k) {
     std::string out;
     Put(out, k.occupied_columns);
@@ -190,7 +150,7 @@ void MergeVoxels(const GridT& from, GridT& into) {
 }
 
 void Merge(const std::string& bytes, Kept& into) {
-    Reader in(bytes);
+    Reader in(bytes, "walls");
     into.occupied_columns += in.Get<size_t>();
     into.voting_columns += in.Get<size_t>();
     const Coord lo = in.Get<Coord>(), hi = in.Get<Coord>();
@@ -389,16 +349,6 @@ size_t ShareOfRank(const Groups& groups, size_t budget, int ranks) {
 }
 
 }  // namespace
-
-double MemoryPerFileByte(const store::MapStore& map, const store::Snapshot& snapshot) {
-    const auto largest = std::max_element(
-        snapshot.tiles.begin(), snapshot.tiles.end(),
-        [](const store::TileVersion& a, const store::TileVersion& b) { return a.bytes < b.bytes; });
-    if (largest == snapshot.tiles.end() || largest->bytes == 0) return 1.0;
-    size_t memory = 0;
-    for (const auto& grid : map.ReadFused(*largest).Grids()) memory += grid->memUsage();
-    return std::max(1.0, static_cast<double>(memory) / static_cast<double>(largest->bytes));
-}
 
 WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                               const walls::WallConfig& config, size_t memory_budget_bytes,

@@ -8,10 +8,6 @@
 
 namespace strata::pipeline::detail {
 
-/// @brief Memory per byte of fused file once a tile is decoded (at least 1), measured on the
-/// snapshot's largest tile: the same on every rank. Budgets count memory, files are compressed.
-[[nodiscard]] double MemoryPerFileByte(const store::MapStore& map, const store::Snapshot& snapshot);
-
 /// @brief The walls of the whole snapshot, reading groups of tiles whose decoded grids (and the
 /// largest neighbour read for their halo) stay within `memory_budget_bytes`
 /// (`memory_per_file_byte`, MemoryPerFileByte's, times their fused files). Equal to

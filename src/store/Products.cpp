@@ -3,6 +3,7 @@
 // analysis: adding one touches no file here.
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 
@@ -134,16 +135,24 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
                     detail::WriteGrids(impl.dir, written.back(), pieces, key);
                 files.push_back(p);
             }
-            const auto e = edited.find(key);
-            if (e == edited.end()) continue;
+            std::optional<core::VoxelMap> tile;
+            if (const auto e = edited.find(key); e != edited.end()) {
+                tile = std::move(e->second);
+                edited.erase(e);
+            } else if (product.edited_tile) {
+                tile = product.edited_tile(key);
+                detail::VoxelizeTiles(*tile);
+            } else {
+                continue;
+            }
             TileVersion v;
             v.key = key;
             const auto l = last.find(key);
             v.version = (l == last.end() ? 0 : l->second) + 1;
-            if (e->second.occupancy->activeVoxelCount() > 0) {
+            if (tile->occupancy->activeVoxelCount() > 0) {
                 written.push_back(detail::FusedFileName(key, v.version));
                 static_cast<FileRef&>(v) =
-                    detail::WriteGrids(impl.dir, written.back(), e->second.Grids(), key);
+                    detail::WriteGrids(impl.dir, written.back(), tile->Grids(), key);
             } else if (!current.count(key)) {
                 continue;  // nothing there before, nothing now
             }

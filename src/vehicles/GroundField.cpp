@@ -4,46 +4,20 @@
 #include <limits>
 #include <stdexcept>
 
+#include "GroundRaster.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 
 namespace strata::vehicles {
 
-namespace {
+namespace detail {
 
-constexpr float kUnknown = std::numeric_limits<float>::quiet_NaN();
-
-// The lowest occupied voxel of every column: its point-mean height and whether it is labelled
-// ground.
-struct Lowest {
-    int32_t k = std::numeric_limits<int32_t>::max();
-    float z = kUnknown;
-    bool ground_label = false;
-};
-
-// The columns a field covers, row by row, and their 8-neighbourhoods.
-struct Raster {
-    int min_i = 0, min_j = 0, width = 0, height = 0;
-
-    [[nodiscard]] size_t Size() const { return static_cast<size_t>(width) * height; }
-    [[nodiscard]] size_t Index(int i, int j) const {
-        return static_cast<size_t>(j - min_j) * width + (i - min_i);
-    }
-    // Calls visit(m) for each neighbour m of column c inside the raster.
-    template <typename Visit>
-    void ForNeighbours(size_t c, Visit&& visit) const {
-        constexpr int kDi[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
-        constexpr int kDj[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
-        const int i = static_cast<int>(c % width) + min_i;
-        const int j = static_cast<int>(c / width) + min_j;
-        for (int d = 0; d < 8; ++d) {
-            const int ni = i + kDi[d], nj = j + kDj[d];
-            if (ni >= min_i && nj >= min_j && ni < min_i + width && nj < min_j + height) {
-                visit(Index(ni, nj));
-            }
-        }
-    }
-};
+Raster Raster::Of(const openvdb::CoordBBox& columns) {
+    if (columns.empty()) return {};
+    // x and y only: a tile's box spans every z, whose extent does not fit an int.
+    return {columns.min().x(), columns.min().y(), columns.max().x() - columns.min().x() + 1,
+            columns.max().y() - columns.min().y() + 1};
+}
 
 std::vector<Lowest> LowestOfColumns(const core::VoxelMap& map, const Raster& raster) {
     std::vector<Lowest> lowest(raster.Size());
@@ -51,6 +25,7 @@ std::vector<Lowest> LowestOfColumns(const core::VoxelMap& map, const Raster& ras
     for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
         if (*it <= 0.0F) continue;
         const openvdb::Coord ijk = it.getCoord();
+        if (!raster.Inside(ijk.x(), ijk.y())) continue;
         Lowest& l = lowest[raster.Index(ijk.x(), ijk.y())];
         if (ijk.z() >= l.k) continue;
         l.k = ijk.z();
@@ -60,50 +35,62 @@ std::vector<Lowest> LowestOfColumns(const core::VoxelMap& map, const Raster& ras
     return lowest;
 }
 
-// Ground columns (1) of the raster. Labelled maps: the lowest voxel is labelled ground.
-// Otherwise regions of columns whose lowest voxels step by at most max_step_m, large enough and
-// not standing above their surroundings (a roof is a flat region higher than its rim).
-std::vector<uint8_t> GroundColumns(const std::vector<Lowest>& lowest, const Raster& raster,
-                                   const GroundConfig& config, double column_area) {
+Regions FindRegions(const std::vector<Lowest>& lowest, const Raster& raster,
+                    const GroundConfig& config, bool open_edges) {
     const size_t n = raster.Size();
-    std::vector<uint8_t> ground(n, 0);
-    std::vector<int32_t> region(n, -1);
+    Regions r;
+    r.of.assign(n, -1);
     std::vector<size_t> queue;
     for (size_t seed = 0; seed < n; ++seed) {
-        if (std::isnan(lowest[seed].z) || region[seed] >= 0) continue;
-        if (config.use_labels && !lowest[seed].ground_label) continue;
+        if (r.of[seed] >= 0 || !IsNode(lowest[seed], config)) continue;
+        const auto id = static_cast<int32_t>(r.columns.size());
+        bool open = false;
         queue.assign(1, seed);
-        region[seed] = static_cast<int32_t>(seed);
-        size_t rim_pairs = 0, rim_lower = 0;
+        r.of[seed] = id;
         for (size_t q = 0; q < queue.size(); ++q) {
             const size_t c = queue[q];
+            open = open || (open_edges && raster.OnEdge(c));
             raster.ForNeighbours(c, [&](size_t m) {
-                if (std::isnan(lowest[m].z) || region[m] == static_cast<int32_t>(seed)) return;
-                const bool joins = std::abs(lowest[m].z - lowest[c].z) <= config.max_step_m &&
-                                   region[m] < 0 && (!config.use_labels || lowest[m].ground_label);
-                if (joins) {
-                    region[m] = static_cast<int32_t>(seed);
+                if (r.of[m] < 0 && IsNode(lowest[m], config) &&
+                    std::abs(lowest[m].z - lowest[c].z) <= config.max_step_m) {
+                    r.of[m] = id;
                     queue.push_back(m);
-                } else {
-                    ++rim_pairs;
-                    if (lowest[m].z < lowest[c].z - config.max_step_m) ++rim_lower;
                 }
             });
         }
-        // A region several times the smallest ground is ground even when most of its rim drops
-        // (a deck with a drain, a garage floor cut by a ramp).
-        const double area = static_cast<double>(queue.size()) * column_area;
-        const bool large = area >= config.min_area_m2;
-        const bool raised = !config.use_labels && area < 4.0 * config.min_area_m2 &&
-                            rim_pairs > 0 && 2 * rim_lower > rim_pairs;
-        if (!large || raised) continue;
-        for (size_t c : queue) ground[c] = 1;
+        r.columns.push_back(queue.size());
+        r.open.push_back(open ? 1 : 0);
     }
-    return ground;
+    r.rim.assign(r.columns.size(), 0);
+    r.lower.assign(r.columns.size(), 0);
+    for (size_t c = 0; c < n; ++c) {
+        const int32_t a = r.of[c];
+        if (a < 0) continue;
+        raster.ForNeighbours(c, [&](size_t m) {
+            const int32_t b = r.of[m];
+            if (b == a || std::isnan(lowest[m].z)) return;
+            const bool lower = lowest[m].z < lowest[c].z - config.max_step_m;
+            if (b >= 0 && r.open[a] && r.open[b]) {
+                r.deferred.push_back({a, b, lower});
+            } else {
+                ++r.rim[a];
+                r.lower[a] += lower ? 1 : 0;
+            }
+        });
+    }
+    return r;
 }
 
-// Fills unknown heights ring by ring from their known neighbours (mean), `passes` rings deep;
-// each pass visits only the columns next to the ones the pass before filled.
+bool IsGroundRegion(size_t columns, size_t rim, size_t lower, const GroundConfig& config,
+                    double column_area) {
+    const double area = static_cast<double>(columns) * column_area;
+    const bool large = area >= config.min_area_m2;
+    const bool raised =
+        !config.use_labels && area < 4.0 * config.min_area_m2 && rim > 0 && 2 * lower > rim;
+    return large && !raised;
+}
+
+// Each pass visits only the columns next to the ones the pass before filled.
 void FillHoles(std::vector<float>& z, const Raster& raster, int passes) {
     std::vector<uint8_t> queued(z.size(), 0);
     std::vector<size_t> frontier, next;
@@ -133,26 +120,48 @@ void FillHoles(std::vector<float>& z, const Raster& raster, int passes) {
     }
 }
 
-}  // namespace
+}  // namespace detail
 
-GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& config) {
-    if (!(config.max_step_m > 0.0 && config.min_area_m2 >= 0.0 && config.fill_radius_m >= 0.0)) {
+void GroundConfig::Validate() const {
+    if (!(max_step_m > 0.0 && min_area_m2 >= 0.0 && fill_radius_m >= 0.0)) {
         throw InvalidArgumentError("ground: max_step_m > 0, min_area_m2 >= 0, fill_radius_m >= 0");
     }
-    GroundField field;
+}
+
+GroundField GroundField::FromMap(const core::VoxelMap& map, const GroundConfig& config) {
+    config.Validate();
     const openvdb::CoordBBox box = map.occupancy->evalActiveVoxelBoundingBox();
-    if (box.empty()) return field;
-    const Raster raster{box.min().x(), box.min().y(), box.dim().x(), box.dim().y()};
+    if (box.empty()) return {};
+    const detail::Raster raster = detail::Raster::Of(box);
+    const std::vector<detail::Lowest> lowest = detail::LowestOfColumns(map, raster);
+    const detail::Regions regions = detail::FindRegions(lowest, raster, config, false);
+    const double column_area = map.voxel_size * map.voxel_size;
+    std::vector<float> z(raster.Size(), detail::kUnknownHeight);
+    for (size_t c = 0; c < raster.Size(); ++c) {
+        const int32_t r = regions.of[c];
+        if (r >= 0 && detail::IsGroundRegion(regions.columns[r], regions.rim[r], regions.lower[r],
+                                             config, column_area)) {
+            z[c] = lowest[c].z;
+        }
+    }
+    return FromMeasured(box, std::move(z), map.voxel_size, config);
+}
+
+GroundField GroundField::FromMeasured(const openvdb::CoordBBox& columns, std::vector<float> z,
+                                      double voxel_size, const GroundConfig& config) {
+    config.Validate();
+    const detail::Raster raster = detail::Raster::Of(columns);
+    if (z.size() != raster.Size() || !(voxel_size > 0.0)) {
+        throw InvalidArgumentError("ground: the measured heights do not cover the columns");
+    }
+    GroundField field;
     field.min_i_ = raster.min_i, field.min_j_ = raster.min_j;
     field.width_ = raster.width, field.height_ = raster.height;
-
-    const std::vector<Lowest> lowest = LowestOfColumns(map, raster);
-    field.measured_ = GroundColumns(lowest, raster, config, map.voxel_size * map.voxel_size);
-    field.z_.assign(raster.Size(), kUnknown);
-    for (size_t c = 0; c < raster.Size(); ++c) {
-        if (field.measured_[c]) field.z_[c] = lowest[c].z;
-    }
-    FillHoles(field.z_, raster, static_cast<int>(std::ceil(config.fill_radius_m / map.voxel_size)));
+    field.measured_.resize(z.size());
+    for (size_t c = 0; c < z.size(); ++c) field.measured_[c] = std::isnan(z[c]) ? 0 : 1;
+    field.z_ = std::move(z);
+    detail::FillHoles(field.z_, raster,
+                      static_cast<int>(std::ceil(config.fill_radius_m / voxel_size)));
     return field;
 }
 

@@ -162,9 +162,15 @@ ObjectSet FindObjects(const core::VoxelMap& map, const GroundField& ground, Vehi
     const std::vector<int> cluster = geometry::Dbscan(voxels, eps, 1);
     std::map<int, std::vector<openvdb::Coord>> groups;
     for (size_t i = 0; i < voxels.size(); ++i) groups[cluster[i]].push_back(voxels[i]);
+    // Each object's voxels and the objects in coordinate order: the same objects in the same
+    // order whichever part of the map was read (a window of it, tile by tile).
     for (auto& [id, group] : groups) {
-        if (group.size() >= config.min_voxels) set.objects.push_back(std::move(group));
+        if (group.size() < config.min_voxels) continue;
+        std::sort(group.begin(), group.end());
+        set.objects.push_back(std::move(group));
     }
+    std::sort(set.objects.begin(), set.objects.end(),
+              [](const auto& a, const auto& b) { return a.front() < b.front(); });
     return set;
 }
 

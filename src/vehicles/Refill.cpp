@@ -52,6 +52,47 @@ struct Eraser {
     openvdb::Int32Grid::Accessor endpoints;
 };
 
+// Writes occupied ground at a voxel, its height `z` as the voxel's point mean (its hit count, no
+// points, is kept).
+struct GroundWriter {
+    GroundWriter(core::VoxelMap& map, float log_odds)
+        : map(map),
+          occupancy(map.occupancy->getAccessor()),
+          label(map.label->getAccessor()),
+          weight(map.label_weight->getAccessor()),
+          endpoints(map.endpoints->getAccessor()),
+          log_odds(log_odds) {}
+    void Write(const openvdb::Coord& c, float z) {
+        occupancy.setValue(c, log_odds);
+        label.setValue(c, static_cast<int32_t>(core::SemanticClass::kGround));
+        weight.setValue(c, 1.0F);
+        const double offset = static_cast<double>(z) - map.VoxelCenter(c).z();
+        const int32_t hits = core::endpoint::Hits(endpoints.getValue(c));
+        endpoints.setValue(
+            c, core::endpoint::Pack(hits, Eigen::Vector3d(0.0, 0.0, offset), map.voxel_size));
+    }
+    const core::VoxelMap& map;
+    openvdb::FloatGrid::Accessor occupancy;
+    openvdb::Int32Grid::Accessor label;
+    openvdb::FloatGrid::Accessor weight;
+    openvdb::Int32Grid::Accessor endpoints;
+    float log_odds;
+};
+
+// Calls fn(voxel, value) for each active voxel of `grid` in the x/y box `columns`.
+template <typename GridT, typename Fn>
+void ForEachVoxelIn(const GridT& grid, const openvdb::CoordBBox& columns, Fn&& fn) {
+    for (auto it = grid.cbeginValueOn(); it; ++it) {
+        const openvdb::CoordBBox voxels = it.getBoundingBox();
+        for (auto v = voxels.begin(); v; ++v) {
+            const openvdb::Coord c = *v;
+            const bool inside = c.x() >= columns.min().x() && c.x() <= columns.max().x() &&
+                                c.y() >= columns.min().y() && c.y() <= columns.max().y();
+            if (inside) fn(c, *it);
+        }
+    }
+}
+
 // z = a + b dx + c dy around `centre`, by least squares with Huber weights (IRLS): a few ring
 // columns on a kerb or a neighbouring car's tyre do not tilt the plane.
 Eigen::Vector3d FitGroundPlane(const std::vector<Eigen::Vector3d>& samples) {
@@ -224,10 +265,7 @@ void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& grou
     }
 
     // Step 4: write occupied ground where the cell was hidden (or never seen).
-    auto occ = map.occupancy->getAccessor();
-    auto label = map.label->getAccessor();
-    auto weight = map.label_weight->getAccessor();
-    auto endpoints = map.endpoints->getAccessor();
+    GroundWriter writer(map, config.refill_log_odds);
     auto mark = refilled.getAccessor();
     for (const Cell& c : cells) {
         // Without a ray check, a cell seen empty is trusted to be a gap.
@@ -235,17 +273,22 @@ void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& grou
             ++vehicle.refused_cells;
             continue;
         }
-        occ.setValue(c.ijk, config.refill_log_odds);
-        label.setValue(c.ijk, static_cast<int32_t>(core::SemanticClass::kGround));
-        weight.setValue(c.ijk, 1.0F);
-        const double offset = c.z - map.VoxelCenter(c.ijk).z();
-        // The refilled height as the voxel's point mean; its hit count (no points) is kept.
-        const int32_t hits = core::endpoint::Hits(endpoints.getValue(c.ijk));
-        endpoints.setValue(
-            c.ijk, core::endpoint::Pack(hits, Eigen::Vector3d(0.0, 0.0, offset), map.voxel_size));
-        mark.setValue(c.ijk, static_cast<float>(c.z));
+        // The height as `refilled` holds it, so that ApplyEdits writes the same voxel.
+        const auto z = static_cast<float>(c.z);
+        writer.Write(c.ijk, z);
+        mark.setValue(c.ijk, z);
         ++vehicle.refilled_cells;
     }
+}
+
+void ApplyEdits(core::VoxelMap& map, const openvdb::Int32Grid& cleared,
+                const openvdb::FloatGrid& refilled, const openvdb::CoordBBox& columns,
+                const VehicleConfig& config) {
+    Eraser eraser(map);
+    ForEachVoxelIn(cleared, columns, [&](const openvdb::Coord& c, int32_t) { eraser.Erase(c); });
+    GroundWriter writer(map, config.refill_log_odds);
+    ForEachVoxelIn(refilled, columns,
+                   [&](const openvdb::Coord& c, float z) { writer.Write(c, z); });
 }
 
 }  // namespace strata::vehicles

@@ -124,4 +124,22 @@ inline const SimulatedScene& BuildingMap(const fs::path& dir, int scans) {
     return building;
 }
 
+/// Tile edge of StreetInSmallTiles: its facades and parked cars cross many tile borders.
+inline constexpr double kSmallTileM = 6.4;
+
+/// datasets/scenes/street.json, 12 scans, integrated in kSmallTileM tiles, once per process:
+/// the map the tile-by-tile analyses are compared with their whole-map selves on (read only).
+inline const fs::path& StreetInSmallTiles() {
+    static const fs::path dir = [] {
+        const fs::path d = Temp("street_small_tiles");
+        ScanSpec scans;
+        scans.kitti = Simulated("street", 12).report.sessions.at(0).dir;
+        IntegrateOptions options;
+        options.map.tile_size_m = kSmallTileM;
+        (void)IntegrateSession(d, scans, options);
+        return d;
+    }();
+    return dir;
+}
+
 }  // namespace strata::pipeline::test

@@ -15,20 +15,6 @@ namespace {
 // The tiled path gives the same candidates in the same order as the whole map, so the same
 // arithmetic: slants equal bit for bit; the tolerance is the one the issue asks for.
 constexpr double kSlantTolDeg = 0.01;
-constexpr double kTileM = 6.4;  // 32 voxels: the street's facades cross many tiles
-
-const fs::path& StreetInSmallTiles() {
-    static const fs::path dir = [] {
-        const fs::path d = Temp("walls_tiles");
-        ScanSpec scans;
-        scans.kitti = Simulated("street", 12).report.sessions.at(0).dir;
-        IntegrateOptions options;
-        options.map.tile_size_m = kTileM;
-        (void)IntegrateSession(d, scans, options);
-        return d;
-    }();
-    return dir;
-}
 
 template <typename GridT>
 void ExpectSameGrid(const openvdb::GridBase::Ptr& a, const openvdb::GridBase::Ptr& b) {

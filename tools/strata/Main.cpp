@@ -37,7 +37,7 @@ const strata::pipeline::Ranks* g_ranks = nullptr;
 bool SharesWork(int argc, char** argv) {
     if (argc < 2) return false;
     const std::string command = argv[1];
-    return command == "integrate" || command == "walls";
+    return command == "integrate" || command == "walls" || command == "vehicles";
 }
 
 // Swallows std::cout and std::cerr while it lives: the output of the ranks other than 0 (rank 0

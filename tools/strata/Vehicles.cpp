@@ -6,9 +6,13 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 #include "strata/vehicles/VehicleReport.hpp"
 
 namespace strata::tools {
@@ -27,6 +31,7 @@ struct VehiclesArgs {
     bool no_ray_check = false;
     bool no_refill = false;
     double picture_height_m = 2.5;
+    double memory_budget_mb = 512.0;
 };
 
 // Median ground height of the vehicles (0 without any): where the picture's cut is measured from.
@@ -38,7 +43,8 @@ double GroundLevel(const vehicles::VehicleResult& result) {
     return z[z.size() / 2];
 }
 
-void PrintSummary(const vehicles::VehicleResult& result, const store::MapStore& map) {
+void PrintSummary(const pipeline::VehiclesOutcome& outcome, const store::MapStore& map) {
+    const vehicles::VehicleResult& result = outcome.result;
     size_t cleared = 0, refilled = 0, refused = 0;
     for (const vehicles::Vehicle& v : result.vehicles) {
         cleared += v.cleared_voxels, refilled += v.refilled_cells, refused += v.refused_cells;
@@ -48,6 +54,12 @@ void PrintSummary(const vehicles::VehicleResult& result, const store::MapStore& 
               << " candidate objects); " << cleared << " voxels cleared, " << refilled
               << " ground cells refilled, " << refused << " refused as seen empty; " << std::fixed
               << std::setprecision(2) << result.seconds << " s\n";
+    if (outcome.tile_groups > 0) {
+        std::cout << "read tile by tile within --memory-budget: " << outcome.tile_groups
+                  << " blocks of tiles";
+        if (CommandRanks().size() > 1) std::cout << " over " << CommandRanks().size() << " ranks";
+        std::cout << "\n";
+    }
     std::cout << "   id  length m  width m  height m  yaw deg  cleared  refilled  refused   "
                  "centre (map frame)\n";
     for (const vehicles::Vehicle& v : result.vehicles) {
@@ -65,21 +77,47 @@ void Run(VehiclesArgs& args) {
     args.config.ray_check = !args.no_ray_check;
     args.config.refill = !args.no_refill;
     const bool save = !args.no_save && args.as_of.empty();
-    store::MapStore map =
-        OpenMap(args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    const store::Snapshot snapshot = SelectSnapshot(map, args.as_of);
-    pipeline::VehiclesOutcome outcome = pipeline::ClearVehicles(map, snapshot, args.config);
+    // Under mpirun every rank reads its share of the tiles; rank 0 joins them, reports and saves.
+    const pipeline::Ranks& ranks = CommandRanks();
+    store::MapStore map = pipeline::OpenOnRanks(args.map, ranks, [&] {
+        return OpenMap(args.map,
+                       save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
+    });
+    std::optional<store::Snapshot> snapshot;
+    pipeline::OnEveryRank(ranks, [&] {
+        if (ranks.root()) snapshot = SelectSnapshot(map, args.as_of);
+    });
+    const auto budget = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    // The picture shows the whole map before and after: refused rather than drawn partly.
+    pipeline::OnEveryRank(ranks, [&] {
+        if (!ranks.root() || args.png.empty()) return;
+        if (ranks.size() > 1) {
+            throw RefusedError(map.dir().string() +
+                               ": --png draws the whole map, which the ranks of mpirun read only "
+                               "in parts; run it in one process");
+        }
+        if (pipeline::VehiclesReadWhole(map, *snapshot, budget)) return;
+        std::ostringstream mb;
+        mb << args.memory_budget_mb;
+        throw RefusedError(map.dir().string() + ": --png draws the whole map, which exceeds " +
+                           "--memory-budget " + mb.str() +
+                           " MB; raise --memory-budget (0: no limit) or leave it out (the " +
+                           "vehicles, --vdb and --json are found tile by tile)");
+    });
+    pipeline::VehiclesOutcome outcome = pipeline::ClearVehiclesOnRanks(
+        map, snapshot ? *snapshot : store::Snapshot{}, args.config, budget, ranks);
+    if (!ranks.root()) return;
     const vehicles::VehicleResult& result = outcome.result;
 
     if (!args.png.empty()) {
-        vehicles::WriteVehiclesPng(map.LoadMap(snapshot), outcome.cleaned, result, args.png,
+        vehicles::WriteVehiclesPng(map.LoadMap(*snapshot), outcome.cleaned, result, args.png,
                                    GroundLevel(result) + args.picture_height_m);
     }
     if (!args.vdb.empty()) WriteGridsFile(vehicles::VehicleGrids(result), args.vdb);
     if (args.json) {
-        std::cout << vehicles::VehiclesJson(result, outcome.cleaned.origin);
+        std::cout << vehicles::VehiclesJson(result, map.settings().origin);
     } else {
-        PrintSummary(result, map);
+        PrintSummary(outcome, map);
     }
     if (save) {
         const int64_t commit = pipeline::StoreVehicles(map, outcome);
@@ -101,6 +139,7 @@ void RegisterVehicles(CLI::App& app) {
         "Examples:\n"
         "  strata vehicles garage.strata --png vehicles.png\n"
         "  strata vehicles street.strata --json --no-save --source geometric\n"
+        "  mpirun -n 2 strata vehicles district.strata --memory-budget 512  # tile by tile\n"
         "Stores the cleaned map (one commit; --as-of the previous session shows it as it was),\n"
         "the vehicle_cleared and vehicle_refilled grids and the vehicles table, unless\n"
         "--no-save or --as-of is given. docs/vehicles.md explains every stage and option.");
@@ -116,6 +155,11 @@ void RegisterVehicles(CLI::App& app) {
     cmd->add_option("--vdb", args->vdb,
                     "Write the vehicle_cleared and vehicle_refilled grids to a .vdb file");
     cmd->add_flag("--no-save", args->no_save, "Do not store the cleaned map");
+    cmd->add_option("--memory-budget", args->memory_budget_mb,
+                    "MB: a map whose fused grids exceed it is read a block of tiles at a time, "
+                    "with a halo (the same vehicles); 0: read whole")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     cmd->add_flag("--no-refill", args->no_refill, "Clear only (no ground refill)");
     cmd->add_flag("--no-ray-check", args->no_ray_check,
                   "Refill without Embree checks: every cell seen empty is taken as a real gap");

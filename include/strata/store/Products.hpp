@@ -3,10 +3,12 @@
 #include <openvdb/openvdb.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "strata/core/VoxelMap.hpp"
+#include "strata/store/Snapshot.hpp"
 
 namespace strata::store {
 
@@ -26,6 +28,9 @@ struct ProductCommit {
     /// One JSON object per row, flat keys (a key is a view column; "id" and "commit_id" are the
     /// view's own).
     std::vector<std::string> rows;
+    /// Instead of `edited`, for a map larger than memory: called once per tile holding a voxel of
+    /// `grids`, in turn, it returns that tile's new fused grids (written, then dropped).
+    std::function<core::VoxelMap(const TileKey&)> edited_tile = {};
 };
 
 /// @brief One row an analysis stored.

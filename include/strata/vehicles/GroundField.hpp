@@ -13,6 +13,9 @@ struct GroundConfig {
     double min_area_m2 = 20.0;   ///< smaller flat regions (car roofs) are not ground
     double fill_radius_m = 4.0;  ///< columns without ground get it from ground this near
     bool use_labels = false;     ///< ground = lowest voxels labelled ground (labelled maps)
+
+    /// @throw InvalidArgumentError for a value out of range.
+    void Validate() const;
 };
 
 /// @brief The ground height of every x/y voxel column of a map: measured where the lowest
@@ -23,6 +26,12 @@ class GroundField {
 public:
     GroundField() = default;
     [[nodiscard]] static GroundField FromMap(const core::VoxelMap& map, const GroundConfig& config);
+    /// @brief The field over the x/y voxel box `columns` whose measured ground heights are `z`
+    /// (row by row, NaN where not measured), the rest filled as FromMap fills it: a window of a
+    /// map read tile by tile, whose measured ground GroundRegions gives.
+    [[nodiscard]] static GroundField FromMeasured(const openvdb::CoordBBox& columns,
+                                                  std::vector<float> z, double voxel_size,
+                                                  const GroundConfig& config);
 
     /// @brief Ground z at column (i, j); NaN when unknown (or outside the raster).
     [[nodiscard]] double Height(int i, int j) const;

@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "strata/core/Error.hpp"
 #include "strata/vehicles/Vehicles.hpp"
 
 namespace strata::vehicles {
@@ -71,5 +72,63 @@ private:
 /// vehicle's counts and plane; marks written cells in `refilled` with their ground z.
 void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& ground,
                   const RayCheck* check, openvdb::FloatGrid& refilled, const VehicleConfig& config);
+
+/// @brief Replays what ClearVehicles did to the voxels of the x/y voxel box `columns` from its
+/// grids alone: the voxels of `cleared` removed from every grid, the cells of `refilled` written
+/// as occupied ground at their height. On the map ClearVehicles was given, the result is the map
+/// it left, voxel for voxel (how a map read tile by tile is edited one tile at a time).
+void ApplyEdits(core::VoxelMap& map, const openvdb::Int32Grid& cleared,
+                const openvdb::FloatGrid& refilled, const openvdb::CoordBBox& columns,
+                const VehicleConfig& config);
+
+/// @brief Where a vehicle comes from, and its place in the order of ids: its object's first voxel
+/// (coordinate order) and its part of the object. Ids follow this order, so that a map read tile
+/// by tile numbers its vehicles as the whole map does.
+struct CarKey {
+    openvdb::Coord first;
+    int part = 0;
+    [[nodiscard]] bool operator<(const CarKey& o) const {
+        return first != o.first ? first < o.first : part < o.part;
+    }
+    [[nodiscard]] bool operator==(const CarKey& o) const {
+        return first == o.first && part == o.part;
+    }
+};
+
+/// @brief A window of a map read tile by tile: the x/y voxel boxes whose results it keeps
+/// (`core`: its tiles) and where its ground field is the whole map's (`exact`).
+struct Window {
+    openvdb::CoordBBox core, exact;
+};
+
+/// @brief What a window contributes to the whole map's ClearVehicles.
+struct WindowVehicles {
+    std::vector<std::pair<CarKey, Vehicle>> vehicles;        ///< objects starting in the core; id 0
+    std::vector<std::pair<openvdb::Coord, CarKey>> cleared;  ///< core voxels, by their vehicle
+    std::vector<std::pair<openvdb::Coord, float>> refilled;  ///< core cells and their ground z
+    size_t candidates = 0;                                   ///< objects starting in the core
+    size_t occluder_faces = 0;
+};
+
+/// @brief ClearVehiclesInWindow needs a larger window (a longer halo) to answer as the whole map.
+class WindowTooSmall : public RefusedError {
+public:
+    using RefusedError::RefusedError;
+};
+
+/// @brief The window's margin around its core (voxels) for ClearVehiclesInWindow: the longest
+/// object (twice the longest car), the ray checks' range and the ground's hole filling.
+[[nodiscard]] int WindowHaloVoxels(double voxel_size, const VehicleConfig& config);
+
+/// @brief ClearVehicles on a window of a map (its core and a halo of WindowHaloVoxels): the
+/// vehicles whose objects start in the core and the edits of the core's voxels, those of
+/// ClearVehicles on the whole map. `map` is edited (read the window's core only afterwards);
+/// `ground` is exact within window.exact; `source` is resolved (not kAuto).
+/// @throw WindowTooSmall when an object near the core reaches out of the window (longer than the
+/// halo allows), naming where: a larger window answers.
+[[nodiscard]] WindowVehicles ClearVehiclesInWindow(core::VoxelMap& map, const GroundField& ground,
+                                                   const std::vector<Eigen::Vector3d>& origins_map,
+                                                   const Window& window, VehicleSource source,
+                                                   const VehicleConfig& config);
 
 }  // namespace strata::vehicles

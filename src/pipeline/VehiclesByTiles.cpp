@@ -1,0 +1,412 @@
+// Vehicles tile by tile. A vehicle is found by the window whose core holds its object's first
+// voxel; windows reach far enough around their core (the longest object, the ray checks' range,
+// the ground's hole filling) that everything the core's vehicles and voxels depend on is what the
+// whole map has there. Only the ground's regions are not local (a street's ground is one region
+// across the map), so a first pass over every tile joins them (vehicles::GroundRegions).
+#include "VehiclesByTiles.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "Bytes.hpp"
+#include "TileBudget.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/core/GridBox.hpp"
+#include "strata/core/Labels.hpp"
+#include "strata/pipeline/RankedSession.hpp"
+#include "strata/store/TileReader.hpp"
+#include "strata/vehicles/GroundRegions.hpp"
+#include "strata/vehicles/VehicleStages.hpp"
+
+namespace strata::pipeline::detail {
+namespace {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+using store::TileKey;
+
+int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+bool HasVehicleLabel(const core::VoxelMap& tile) {
+    const int32_t vehicle = static_cast<int32_t>(core::SemanticClass::kVehicle);
+    for (auto it = tile.label->cbeginValueOn(); it; ++it) {
+        if (*it == vehicle) return true;
+    }
+    return false;
+}
+
+// Square blocks of `side` x `side` tiles, each read with the tiles within `halo` voxels of it.
+class Blocks {
+public:
+    Blocks(const store::Snapshot& snapshot, const store::MapSettings& settings, int halo,
+           double memory_per_file_byte)
+        : settings_(settings), halo_tiles_(HaloTiles(halo)) {
+        for (const store::TileVersion& t : snapshot.tiles) {
+            bytes_[t.key] = static_cast<uint64_t>(
+                std::ceil(static_cast<double>(t.bytes) * memory_per_file_byte));
+        }
+    }
+
+    // The largest side whose every block's window fits the budget (0: no limit), at most so
+    // large that each of `ranks` gets a block.
+    [[nodiscard]] int Side(size_t budget, int ranks, const std::string& dir) {
+        int side = 1;
+        const uint64_t one = Largest(1);
+        if (budget > 0 && one > budget) {
+            throw RefusedError(dir + ": a tile with its halo of " + std::to_string(halo_tiles_) +
+                               " tiles takes about " + Megabytes(static_cast<double>(one)) +
+                               " in memory, more than the memory budget of " +
+                               Megabytes(static_cast<double>(budget)) + "; raise --memory-budget");
+        }
+        for (int next = 2; next <= 64; ++next) {
+            if (budget > 0 && Largest(next) > budget) break;
+            if (Of(next).size() < static_cast<size_t>(ranks)) break;
+            side = next;
+        }
+        side_ = side;
+        return side;
+    }
+    // The blocks holding a tile, by their index.
+    [[nodiscard]] std::vector<std::pair<int, int>> Of(int side) const {
+        std::set<std::pair<int, int>> blocks;
+        for (const auto& [key, bytes] : bytes_) {
+            blocks.insert({FloorDiv(key.x, side), FloorDiv(key.y, side)});
+        }
+        return {blocks.begin(), blocks.end()};
+    }
+    [[nodiscard]] CoordBBox Core(const std::pair<int, int>& b) const {
+        const TileKey lo{b.first * side_, b.second * side_};
+        const TileKey hi{lo.x + side_ - 1, lo.y + side_ - 1};
+        return {settings_.TileBounds(lo).min(), settings_.TileBounds(hi).max()};
+    }
+    // The tiles of a block's window (present or not) and its columns.
+    [[nodiscard]] std::vector<TileKey> Window(const std::pair<int, int>& b, int side,
+                                              int halo_tiles = -1) const {
+        const int h = halo_tiles < 0 ? halo_tiles_ : halo_tiles;
+        std::vector<TileKey> keys;
+        for (int x = b.first * side - h; x < (b.first + 1) * side + h; ++x) {
+            for (int y = b.second * side - h; y < (b.second + 1) * side + h; ++y) {
+                keys.push_back({x, y});
+            }
+        }
+        return keys;
+    }
+    [[nodiscard]] bool Present(const TileKey& k) const { return bytes_.count(k) > 0; }
+    [[nodiscard]] int HaloTiles(int halo_voxels) const {
+        return (halo_voxels + settings_.tile_voxels - 1) / settings_.tile_voxels;
+    }
+    // Memory of a window's tiles.
+    [[nodiscard]] uint64_t Cost(const std::vector<TileKey>& window) const {
+        uint64_t sum = 0;
+        for (const TileKey& k : window) {
+            const auto it = bytes_.find(k);
+            if (it != bytes_.end()) sum += it->second;
+        }
+        return sum;
+    }
+
+private:
+    [[nodiscard]] uint64_t Largest(int side) const {
+        uint64_t largest = 0;
+        for (const auto& b : Of(side)) largest = std::max(largest, Cost(Window(b, side)));
+        return largest;
+    }
+    const store::MapSettings& settings_;
+    int halo_tiles_;
+    int side_ = 1;
+    std::map<TileKey, uint64_t> bytes_;
+};
+
+// Pass 1: the ground's regions over every tile, and the source `auto` resolves to.
+vehicles::GroundRegions JoinGround(const store::TileReader& reader,
+                                   const store::MapSettings& settings,
+                                   const std::vector<TileKey>& keys,
+                                   const vehicles::VehicleConfig& config,
+                                   vehicles::VehicleSource& source) {
+    vehicles::GroundConfig labelled = config.ground, geometric = config.ground;
+    labelled.use_labels = true;
+    geometric.use_labels = false;
+    std::optional<vehicles::GroundRegions> by_labels, by_geometry;
+    if (source != vehicles::VehicleSource::kGeometric)
+        by_labels.emplace(labelled, settings.voxel_size_m);
+    if (source != vehicles::VehicleSource::kLabel)
+        by_geometry.emplace(geometric, settings.voxel_size_m);
+    bool vehicle_label = false;
+    for (const TileKey& key : keys) {
+        const auto tile = reader.Fused(key);
+        if (!tile) continue;
+        const CoordBBox box = settings.TileBounds(key);
+        if (by_labels) by_labels->AddTile(*tile, box);
+        if (by_geometry) by_geometry->AddTile(*tile, box);
+        if (source == vehicles::VehicleSource::kAuto && !vehicle_label) {
+            vehicle_label = HasVehicleLabel(*tile);
+        }
+    }
+    if (source == vehicles::VehicleSource::kAuto) {
+        source =
+            vehicle_label ? vehicles::VehicleSource::kLabel : vehicles::VehicleSource::kGeometric;
+    }
+    vehicles::GroundRegions& chosen =
+        source == vehicles::VehicleSource::kLabel ? *by_labels : *by_geometry;
+    chosen.Join();
+    return std::move(chosen);
+}
+
+// The window's ground field: the measured heights of its tiles, filled within the map's raster.
+vehicles::GroundField WindowGround(const vehicles::GroundRegions& regions,
+                                   const core::VoxelMap& window, const CoordBBox& columns,
+                                   double voxel_size, const vehicles::GroundConfig& config,
+                                   size_t& measured_in_core, const CoordBBox& core) {
+    const std::vector<float> z = regions.Measured(window, columns);
+    const CoordBBox& bounds = regions.bounds();
+    const int i0 = std::max(columns.min().x(), bounds.min().x());
+    const int j0 = std::max(columns.min().y(), bounds.min().y());
+    const int i1 = std::min(columns.max().x(), bounds.max().x());
+    const int j1 = std::min(columns.max().y(), bounds.max().y());
+    if (i1 < i0 || j1 < j0) return {};
+    const int width = columns.max().x() - columns.min().x() + 1;
+    std::vector<float> clipped;
+    clipped.reserve(static_cast<size_t>(i1 - i0 + 1) * static_cast<size_t>(j1 - j0 + 1));
+    for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+            const float value = z[static_cast<size_t>(j - columns.min().y()) * width +
+                                  static_cast<size_t>(i - columns.min().x())];
+            clipped.push_back(value);
+            const bool in_core = i >= core.min().x() && i <= core.max().x() &&
+                                 j >= core.min().y() && j <= core.max().y();
+            if (in_core && !std::isnan(value)) ++measured_in_core;
+        }
+    }
+    return vehicles::GroundField::FromMeasured(CoordBBox(Coord(i0, j0, 0), Coord(i1, j1, 0)),
+                                               std::move(clipped), voxel_size, config);
+}
+
+// One window: its tiles read, its ground field, its vehicles; the measured ground columns of
+// its core are counted into `result`.
+vehicles::WindowVehicles ClearWindow(
+    const store::TileReader& reader, const Blocks& blocks, const store::MapSettings& settings,
+    const vehicles::GroundRegions& regions, const std::vector<TileKey>& keys,
+    const vehicles::Window& bounds, const std::vector<Eigen::Vector3d>& origins,
+    vehicles::VehicleResult& result, const vehicles::GroundConfig& ground_config,
+    const vehicles::VehicleConfig& config) {
+    std::vector<TileKey> present;
+    CoordBBox columns;
+    for (const TileKey& k : keys) {
+        columns.expand(settings.TileBounds(k));
+        if (blocks.Present(k)) present.push_back(k);
+    }
+    core::VoxelMap window = reader.LoadFused(present);
+    size_t measured = 0;
+    const vehicles::GroundField ground = WindowGround(
+        regions, window, columns, settings.voxel_size_m, ground_config, measured, bounds.core);
+    vehicles::WindowVehicles found =
+        vehicles::ClearVehiclesInWindow(window, ground, origins, bounds, result.source, config);
+    result.ground_columns += measured;
+    return found;
+}
+
+// What a rank found, in bytes for rank 0 (docs/scale.md).
+struct FlatKey {
+    int32_t x, y, z, part;
+};
+FlatKey Flat(const vehicles::CarKey& k) { return {k.first.x(), k.first.y(), k.first.z(), k.part}; }
+vehicles::CarKey Unflat(const FlatKey& k) { return {Coord(k.x, k.y, k.z), k.part}; }
+struct FlatVehicle {
+    FlatKey key;
+    int32_t source;
+    double footprint[5], seen[5], ground_z, height, plane[3];
+    uint64_t voxels, cleared, refilled, refused, already_ground, ring;
+};
+struct FlatCleared {
+    int32_t x, y, z;
+    FlatKey key;
+};
+struct FlatRefilled {
+    int32_t x, y, z;
+    float ground_z;
+};
+void PutRect(const vehicles::OrientedRect& r, double* out) {
+    out[0] = r.center.x(), out[1] = r.center.y(), out[2] = r.length, out[3] = r.width;
+    out[4] = r.yaw_rad;
+}
+vehicles::OrientedRect GetRect(const double* in) {
+    vehicles::OrientedRect r;
+    r.center = {in[0], in[1]}, r.length = in[2], r.width = in[3], r.yaw_rad = in[4];
+    return r;
+}
+
+std::string Encode(const std::vector<vehicles::WindowVehicles>& found, size_t ground_columns) {
+    std::vector<FlatVehicle> cars;
+    std::vector<FlatCleared> cleared;
+    std::vector<FlatRefilled> refilled;
+    uint64_t candidates = 0, faces = 0;
+    for (const vehicles::WindowVehicles& w : found) {
+        for (const auto& [key, v] : w.vehicles) {
+            FlatVehicle f{};
+            f.key = Flat(key);
+            f.source = static_cast<int32_t>(v.source);
+            PutRect(v.footprint, f.footprint);
+            PutRect(v.seen, f.seen);
+            f.ground_z = v.ground_z, f.height = v.height;
+            for (int k = 0; k < 3; ++k) f.plane[k] = v.ground_plane[k];
+            f.voxels = v.voxels, f.cleared = v.cleared_voxels, f.refilled = v.refilled_cells;
+            f.refused = v.refused_cells, f.already_ground = v.already_ground_cells;
+            f.ring = v.ring_cells;
+            cars.push_back(f);
+        }
+        for (const auto& [c, key] : w.cleared) cleared.push_back({c.x(), c.y(), c.z(), Flat(key)});
+        for (const auto& [c, z] : w.refilled) refilled.push_back({c.x(), c.y(), c.z(), z});
+        candidates += w.candidates, faces += w.occluder_faces;
+    }
+    std::string out;
+    Put(out, static_cast<uint64_t>(ground_columns));
+    Put(out, candidates);
+    Put(out, faces);
+    PutVector(out, cars);
+    PutVector(out, cleared);
+    PutVector(out, refilled);
+    return out;
+}
+
+vehicles::WindowVehicles Decode(const std::string& bytes, size_t& ground_columns) {
+    Reader in(bytes, "vehicles");
+    vehicles::WindowVehicles w;
+    ground_columns += in.Get<uint64_t>();
+    w.candidates = in.Get<uint64_t>();
+    w.occluder_faces = in.Get<uint64_t>();
+    for (const FlatVehicle& f : in.GetVector<FlatVehicle>()) {
+        vehicles::Vehicle v;
+        v.source = static_cast<vehicles::VehicleSource>(f.source);
+        v.footprint = GetRect(f.footprint), v.seen = GetRect(f.seen);
+        v.ground_z = f.ground_z, v.height = f.height;
+        v.ground_plane = {f.plane[0], f.plane[1], f.plane[2]};
+        v.voxels = f.voxels, v.cleared_voxels = f.cleared, v.refilled_cells = f.refilled;
+        v.refused_cells = f.refused, v.already_ground_cells = f.already_ground;
+        v.ring_cells = f.ring;
+        w.vehicles.emplace_back(Unflat(f.key), v);
+    }
+    for (const FlatCleared& c : in.GetVector<FlatCleared>()) {
+        w.cleared.emplace_back(Coord(c.x, c.y, c.z), Unflat(c.key));
+    }
+    for (const FlatRefilled& r : in.GetVector<FlatRefilled>()) {
+        w.refilled.emplace_back(Coord(r.x, r.y, r.z), r.ground_z);
+    }
+    return w;
+}
+
+}  // namespace
+
+VehiclesOutcome ClearVehiclesByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
+                                     const vehicles::VehicleConfig& config,
+                                     size_t memory_budget_bytes, double memory_per_file_byte,
+                                     const Ranks& ranks) {
+    const auto start = std::chrono::steady_clock::now();
+    const store::MapSettings& settings = map.settings();
+    const double s = settings.voxel_size_m;
+    const int halo = vehicles::WindowHaloVoxels(s, config);
+    const store::TileReader reader(map, snapshot, 0);
+    std::vector<TileKey> keys;
+    for (const store::TileVersion& t : snapshot.tiles) keys.push_back(t.key);
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+
+    VehiclesOutcome outcome;
+    outcome.commit = snapshot.commit;
+    outcome.config = config;
+    vehicles::VehicleResult& result = outcome.result;
+    result.source = config.source;
+    const vehicles::GroundRegions regions =
+        JoinGround(reader, settings, keys, config, result.source);
+    vehicles::GroundConfig ground_config = config.ground;
+    ground_config.use_labels = result.source == vehicles::VehicleSource::kLabel;
+
+    Blocks blocks(snapshot, settings, halo, memory_per_file_byte);
+    const int side = blocks.Side(memory_budget_bytes, ranks.size(), map.dir().string());
+    const std::vector<std::pair<int, int>> mine = blocks.Of(side);
+    const std::vector<Eigen::Vector3d> origins = SensorOrigins(map, snapshot);
+    const int passes = static_cast<int>(std::ceil(config.ground.fill_radius_m / s));
+    std::vector<vehicles::WindowVehicles> found;
+    OnEveryRank(ranks, [&] {
+        for (size_t b = static_cast<size_t>(ranks.rank()); b < mine.size();
+             b += static_cast<size_t>(ranks.size())) {
+            // An object longer than the halo: the window grows (twice the halo, ...) while it
+            // fits the budget.
+            std::string too_small;
+            for (int reach = halo;; reach *= 2) {
+                const std::vector<TileKey> keys_in =
+                    blocks.Window(mine[b], side, blocks.HaloTiles(reach));
+                const uint64_t cost = blocks.Cost(keys_in);
+                if (reach > halo && memory_budget_bytes > 0 && cost > memory_budget_bytes) {
+                    throw RefusedError(
+                        map.dir().string() + ": " + too_small + " (" + std::to_string(reach / 2) +
+                        " voxels of halo); a larger window takes about " +
+                        Megabytes(static_cast<double>(cost)) + ", more than the memory budget of " +
+                        Megabytes(static_cast<double>(memory_budget_bytes)) +
+                        "; raise --memory-budget");
+                }
+                try {
+                    const vehicles::Window bounds{
+                        blocks.Core(mine[b]),
+                        core::GrownXY(blocks.Core(mine[b]), reach - passes - 1)};
+                    found.push_back(ClearWindow(reader, blocks, settings, regions, keys_in, bounds,
+                                                origins, result, ground_config, config));
+                    break;
+                } catch (const vehicles::WindowTooSmall& e) {
+                    too_small = e.what();
+                }
+            }
+            ++outcome.tile_groups;
+        }
+    });
+    if (ranks.size() > 1) {
+        const std::vector<std::string> all =
+            ranks.Gather(ranks.root() ? "" : Encode(found, result.ground_columns));
+        if (!ranks.root()) return outcome;
+        for (size_t r = 1; r < all.size(); ++r) {
+            found.push_back(Decode(all[r], result.ground_columns));
+        }
+    }
+    // Ids in key order, as the whole map numbers its vehicles.
+    std::vector<std::pair<vehicles::CarKey, vehicles::Vehicle>> cars;
+    for (const vehicles::WindowVehicles& w : found) {
+        cars.insert(cars.end(), w.vehicles.begin(), w.vehicles.end());
+        result.candidates += w.candidates;
+        result.occluder_faces += w.occluder_faces;
+    }
+    std::sort(cars.begin(), cars.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::map<vehicles::CarKey, int> ids;
+    for (auto& [key, vehicle] : cars) {
+        vehicle.id = static_cast<int>(ids.size()) + 1;
+        ids[key] = vehicle.id;
+        result.vehicles.push_back(vehicle);
+    }
+    result.cleared = openvdb::Int32Grid::create(0);
+    result.cleared->setName(vehicles::grid_names::kCleared);
+    result.refilled = openvdb::FloatGrid::create(0.0F);
+    result.refilled->setName(vehicles::grid_names::kRefilled);
+    for (const auto& grid :
+         {openvdb::GridBase::Ptr(result.cleared), openvdb::GridBase::Ptr(result.refilled)}) {
+        grid->setTransform(core::VoxelMap::MakeTransform(s));
+        grid->setGridClass(openvdb::GRID_UNKNOWN);
+    }
+    auto cleared = result.cleared->getAccessor();
+    auto refilled = result.refilled->getAccessor();
+    for (const vehicles::WindowVehicles& w : found) {
+        for (const auto& [c, key] : w.cleared) cleared.setValue(c, ids.at(key));
+        for (const auto& [c, z] : w.refilled) refilled.setValue(c, z);
+    }
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return outcome;
+}
+
+}  // namespace strata::pipeline::detail
