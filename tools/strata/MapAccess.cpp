@@ -1,9 +1,12 @@
 #include "MapAccess.hpp"
 
 #include <cstdlib>
+#include <sstream>
 
+#include "strata/core/Error.hpp"
 #include "strata/io/AtomicFile.hpp"
 #include "strata/io/VdbExport.hpp"
+#include "strata/pipeline/RankedSession.hpp"
 
 namespace strata::tools {
 
@@ -23,6 +26,26 @@ void WriteTextFile(const std::string& path, const std::string& text) {
 
 void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path) {
     io::WriteGrids(openvdb::GridCPtrVec(grids.begin(), grids.end()), {}, path);
+}
+
+void RefuseWholeMapOutputs(const store::MapStore& map, const pipeline::Ranks& ranks, bool wanted,
+                           const std::string& what, const std::function<bool()>& read_whole,
+                           double budget_mb, const std::string& instead) {
+    pipeline::OnEveryRank(ranks, [&] {
+        if (!ranks.root() || !wanted) return;
+        if (ranks.size() > 1) {
+            throw RefusedError(map.dir().string() + ": " + what +
+                               " draw the whole map, which the ranks of mpirun read only in "
+                               "parts; run them in one process");
+        }
+        if (read_whole()) return;
+        std::ostringstream mb;
+        mb << budget_mb;
+        throw RefusedError(map.dir().string() + ": " + what +
+                           " draw the whole map, which exceeds --memory-budget " + mb.str() +
+                           " MB; raise --memory-budget (0: no limit) or leave them out (" +
+                           instead + " are found tile by tile)");
+    });
 }
 
 }  // namespace strata::tools

@@ -2,9 +2,11 @@
 // Shared by subcommands: where data lives and how a map is opened and read.
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "strata/pipeline/MapAccess.hpp"
+#include "strata/pipeline/Ranks.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::tools {
@@ -21,5 +23,14 @@ using pipeline::SelectSnapshot;
 void WriteTextFile(const std::string& path, const std::string& text);
 /// Writes grids to a .vdb file.
 void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path);
+
+/// On every rank: refuses outputs that draw the whole map (`what`, e.g. "--png") when the ranks of
+/// mpirun read it in parts or, in one process, when it is read tile by tile (`read_whole` false
+/// under --memory-budget `budget_mb`); `instead` names what is found tile by tile. Nothing when
+/// `wanted` is false.
+/// @throw RefusedError naming the option and the budget.
+void RefuseWholeMapOutputs(const store::MapStore& map, const pipeline::Ranks& ranks, bool wanted,
+                           const std::string& what, const std::function<bool()>& read_whole,
+                           double budget_mb, const std::string& instead);
 
 }  // namespace strata::tools

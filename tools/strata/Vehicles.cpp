@@ -89,21 +89,10 @@ void Run(VehiclesArgs& args) {
     });
     const auto budget = static_cast<size_t>(args.memory_budget_mb * 1e6);
     // The picture shows the whole map before and after: refused rather than drawn partly.
-    pipeline::OnEveryRank(ranks, [&] {
-        if (!ranks.root() || args.png.empty()) return;
-        if (ranks.size() > 1) {
-            throw RefusedError(map.dir().string() +
-                               ": --png draws the whole map, which the ranks of mpirun read only "
-                               "in parts; run it in one process");
-        }
-        if (pipeline::VehiclesReadWhole(map, *snapshot, budget)) return;
-        std::ostringstream mb;
-        mb << args.memory_budget_mb;
-        throw RefusedError(map.dir().string() + ": --png draws the whole map, which exceeds " +
-                           "--memory-budget " + mb.str() +
-                           " MB; raise --memory-budget (0: no limit) or leave it out (the " +
-                           "vehicles, --vdb and --json are found tile by tile)");
-    });
+    RefuseWholeMapOutputs(
+        map, ranks, !args.png.empty(), "--png",
+        [&] { return pipeline::VehiclesReadWhole(map, *snapshot, budget); }, args.memory_budget_mb,
+        "the vehicles, --vdb and --json");
     pipeline::VehiclesOutcome outcome = pipeline::ClearVehiclesOnRanks(
         map, snapshot ? *snapshot : store::Snapshot{}, args.config, budget, ranks);
     if (!ranks.root()) return;

@@ -89,21 +89,10 @@ void Run(const WallsArgs& args) {
     // the voxels near wall candidates are kept, so they are refused rather than drawn partly.
     const bool whole_map_outputs = !args.png.empty() || !args.columns_csv.empty() ||
                                    !args.columns_png.empty() || !args.columns_vdb.empty();
-    pipeline::OnEveryRank(ranks, [&] {
-        if (!ranks.root() || !whole_map_outputs) return;
-        if (ranks.size() > 1) {
-            throw RefusedError(map.dir().string() +
-                               ": --png and --columns-* draw the whole map, which the ranks of "
-                               "mpirun read only in parts; run them in one process");
-        }
-        if (pipeline::WallsReadWhole(map, *snapshot, budget)) return;
-        std::ostringstream mb;
-        mb << args.memory_budget_mb;
-        throw RefusedError(map.dir().string() + ": --png and --columns-* draw the whole map, " +
-                           "which exceeds --memory-budget " + mb.str() +
-                           " MB; raise --memory-budget (0: no limit) or leave them out (the " +
-                           "walls, --csv, --vdb and --json are found tile by tile)");
-    });
+    RefuseWholeMapOutputs(
+        map, ranks, whole_map_outputs, "--png and --columns-*",
+        [&] { return pipeline::WallsReadWhole(map, *snapshot, budget); }, args.memory_budget_mb,
+        "the walls, --csv, --vdb and --json");
     const pipeline::WallsOutcome outcome = pipeline::FindWallsOnRanks(
         map, snapshot ? *snapshot : store::Snapshot{}, args.config, budget, ranks);
     if (!ranks.root()) return;
