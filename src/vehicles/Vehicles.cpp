@@ -145,19 +145,6 @@ void ClearAndRefill(core::VoxelMap& map, std::vector<Car>& cars, const GroundFie
     for (Car& car : cars) RefillGround(map, car.object.vehicle, ground, check, refilled, config);
 }
 
-std::pair<openvdb::Int32Grid::Ptr, openvdb::FloatGrid::Ptr> ProductGrids(
-    const core::VoxelMap& map) {
-    auto cleared = openvdb::Int32Grid::create(0);
-    cleared->setName(grid_names::kCleared);
-    auto refilled = openvdb::FloatGrid::create(0.0F);
-    refilled->setName(grid_names::kRefilled);
-    for (const auto& grid : {openvdb::GridBase::Ptr(cleared), openvdb::GridBase::Ptr(refilled)}) {
-        grid->setTransform(map.occupancy->transform().copy());
-        grid->setGridClass(openvdb::GRID_UNKNOWN);
-    }
-    return {cleared, refilled};
-}
-
 double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -213,12 +200,25 @@ VehicleResult ClearVehicles(core::VoxelMap& map, const std::vector<Eigen::Vector
     if (check) result.occluder_faces = check->faces();
 
     // Step 3: clear every vehicle, then refill under each.
-    std::tie(result.cleared, result.refilled) = ProductGrids(map);
+    std::tie(result.cleared, result.refilled) = NewVehicleGrids(map.occupancy->transform());
     ClearAndRefill(map, cars, ground, *set.kept, check.get(), *result.cleared, *result.refilled,
                    config);
     for (const Car& car : cars) result.vehicles.push_back(car.object.vehicle);
     result.seconds = SecondsSince(start);
     return result;
+}
+
+std::pair<openvdb::Int32Grid::Ptr, openvdb::FloatGrid::Ptr> NewVehicleGrids(
+    const openvdb::math::Transform& transform) {
+    auto cleared = openvdb::Int32Grid::create(0);
+    cleared->setName(grid_names::kCleared);
+    auto refilled = openvdb::FloatGrid::create(0.0F);
+    refilled->setName(grid_names::kRefilled);
+    for (const auto& grid : {openvdb::GridBase::Ptr(cleared), openvdb::GridBase::Ptr(refilled)}) {
+        grid->setTransform(transform.copy());
+        grid->setGridClass(openvdb::GRID_UNKNOWN);
+    }
+    return {cleared, refilled};
 }
 
 int WindowHaloVoxels(double voxel_size, const VehicleConfig& config) {
@@ -310,7 +310,7 @@ WindowVehicles ClearVehiclesInWindow(core::VoxelMap& map, const GroundField& gro
     const std::unique_ptr<RayCheck> check =
         MakeRayCheck(map, ground, involved, origins_map, &window.exact, config);
     if (check) out.occluder_faces = check->faces();
-    auto [cleared, refilled] = ProductGrids(map);
+    auto [cleared, refilled] = NewVehicleGrids(map.occupancy->transform());
     ClearAndRefill(map, involved, ground, *set.kept, check.get(), *cleared, *refilled, config);
     for (const Car& car : involved) {
         if (in_core(car.key.first)) out.vehicles.emplace_back(car.key, car.object.vehicle);

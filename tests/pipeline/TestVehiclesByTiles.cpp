@@ -4,6 +4,7 @@
 
 #include <set>
 
+#include "MapDiff.hpp"
 #include "PipelineTestUtil.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/Vehicles.hpp"
@@ -30,19 +31,6 @@ size_t TiledBudget(const store::MapStore& map, const store::Snapshot& snapshot) 
     return bytes * 9 / 10;
 }
 
-template <typename GridT>
-size_t DifferentVoxels(const GridT& a, const GridT& b) {
-    size_t differ = 0;
-    for (const auto* grids : {&a, &b}) {
-        const GridT& other = grids == &a ? b : a;
-        auto acc = other.getConstAccessor();
-        for (auto it = grids->cbeginValueOn(); it; ++it) {
-            differ += !acc.isValueOn(it.getCoord()) || acc.getValue(it.getCoord()) != *it;
-        }
-    }
-    return differ;
-}
-
 void ExpectSameVehicles(const vehicles::VehicleResult& t, const vehicles::VehicleResult& w) {
     EXPECT_EQ(t.source, w.source);
     EXPECT_EQ(t.candidates, w.candidates);
@@ -66,8 +54,8 @@ void ExpectSameVehicles(const vehicles::VehicleResult& t, const vehicles::Vehicl
         EXPECT_EQ(a.ring_cells, b.ring_cells);
         EXPECT_EQ(a.ground_plane, b.ground_plane);
     }
-    EXPECT_EQ(DifferentVoxels(*t.cleared, *w.cleared), 0u);
-    EXPECT_EQ(DifferentVoxels(*t.refilled, *w.refilled), 0u);
+    EXPECT_EQ(strata::testing::FirstDifference("cleared", *t.cleared, *w.cleared), "");
+    EXPECT_EQ(strata::testing::FirstDifference("refilled", *t.refilled, *w.refilled), "");
 }
 
 TEST(VehiclesByTiles, TileByTileClearsTheWholeMapsVehicles) {
@@ -130,12 +118,9 @@ TEST(VehiclesByTiles, StoredTileByTileTheCleanedMapIsTheWholeMapsVoxelForVoxel) 
     ASSERT_GT(tiled.tile_groups, 1u);
     (void)StoreVehicles(whole_map, whole);
     (void)StoreVehicles(tiled_map, tiled);
-    const core::VoxelMap a = whole_map.LoadMap(whole_map.Latest());
-    const core::VoxelMap b = tiled_map.LoadMap(tiled_map.Latest());
-    EXPECT_EQ(DifferentVoxels(*a.occupancy, *b.occupancy), 0u);
-    EXPECT_EQ(DifferentVoxels(*a.label, *b.label), 0u);
-    EXPECT_EQ(DifferentVoxels(*a.label_weight, *b.label_weight), 0u);
-    EXPECT_EQ(DifferentVoxels(*a.endpoints, *b.endpoints), 0u);
+    EXPECT_EQ(strata::testing::MapDifference(tiled_map.LoadMap(tiled_map.Latest()),
+                                             whole_map.LoadMap(whole_map.Latest())),
+              "");
     EXPECT_EQ(whole_map.ProductRows("vehicles").size(), tiled_map.ProductRows("vehicles").size());
 }
 

@@ -28,6 +28,21 @@ void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path) {
     io::WriteGrids(openvdb::GridCPtrVec(grids.begin(), grids.end()), {}, path);
 }
 
+MapOnRanks OpenMapOnRanks(const std::string& path, const std::string& as_of, bool save,
+                          const pipeline::Ranks& ranks) {
+    MapOnRanks opened{pipeline::OpenOnRanks(path, ranks,
+                                            [&] {
+                                                return OpenMap(
+                                                    path, save ? store::MapStore::Access::kWrite
+                                                               : store::MapStore::Access::kRead);
+                                            }),
+                      std::nullopt};
+    pipeline::OnEveryRank(ranks, [&] {
+        if (ranks.root()) opened.snapshot = SelectSnapshot(opened.map, as_of);
+    });
+    return opened;
+}
+
 void RefuseWholeMapOutputs(const store::MapStore& map, const pipeline::Ranks& ranks, bool wanted,
                            const std::string& what, const std::function<bool()>& read_whole,
                            double budget_mb, const std::string& instead) {

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "strata/pipeline/MapAccess.hpp"
@@ -23,6 +24,18 @@ using pipeline::SelectSnapshot;
 void WriteTextFile(const std::string& path, const std::string& text);
 /// Writes grids to a .vdb file.
 void WriteGridsFile(const openvdb::GridPtrVec& grids, const std::string& path);
+
+/// A map an analysis reads on every rank of the command, and the snapshot rank 0 picked.
+struct MapOnRanks {
+    store::MapStore map;
+    std::optional<store::Snapshot>
+        snapshot;  ///< rank 0's (`--as-of`, else the newest); others: none
+};
+/// Opens `path` on every rank (for writing on rank 0 when the analysis will `save`: a busy map
+/// fails before any work) and selects rank 0's snapshot (`as_of`: a session, "" the newest).
+/// @throw what opening or selecting threw, on every rank.
+[[nodiscard]] MapOnRanks OpenMapOnRanks(const std::string& path, const std::string& as_of,
+                                        bool save, const pipeline::Ranks& ranks);
 
 /// On every rank: refuses outputs that draw the whole map (`what`, e.g. "--png") when the ranks of
 /// mpirun read it in parts or, in one process, when it is read tile by tile (`read_whole` false

@@ -76,14 +76,9 @@ void Run(const WallsArgs& args) {
     const bool save = !args.no_save && args.as_of.empty();
     // Under mpirun every rank reads its share of the tiles; rank 0 joins them, reports and saves.
     const pipeline::Ranks& ranks = CommandRanks();
-    store::MapStore map = pipeline::OpenOnRanks(args.map, ranks, [&] {
-        return OpenMap(args.map,
-                       save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    });
-    std::optional<store::Snapshot> snapshot;
-    pipeline::OnEveryRank(ranks, [&] {
-        if (ranks.root()) snapshot = SelectSnapshot(map, args.as_of);
-    });
+    MapOnRanks opened = OpenMapOnRanks(args.map, args.as_of, save, ranks);
+    store::MapStore& map = opened.map;
+    const std::optional<store::Snapshot>& snapshot = opened.snapshot;
     const auto budget = static_cast<size_t>(args.memory_budget_mb * 1e6);
     // The slant picture and the column statistics cover the whole map: read tile by tile, only
     // the voxels near wall candidates are kept, so they are refused rather than drawn partly.

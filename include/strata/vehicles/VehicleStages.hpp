@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "strata/core/Error.hpp"
@@ -80,6 +81,10 @@ void RefillGround(core::VoxelMap& map, Vehicle& vehicle, const GroundField& grou
 void ApplyEdits(core::VoxelMap& map, const openvdb::Int32Grid& cleared,
                 const openvdb::FloatGrid& refilled, const openvdb::CoordBBox& columns,
                 const VehicleConfig& config);
+
+/// @brief The empty `vehicle_cleared` and `vehicle_refilled` grids, on the map's `transform`.
+[[nodiscard]] std::pair<openvdb::Int32Grid::Ptr, openvdb::FloatGrid::Ptr> NewVehicleGrids(
+    const openvdb::math::Transform& transform);
 
 /// @brief Where a vehicle comes from, and its place in the order of ids: its object's first voxel
 /// (coordinate order) and its part of the object. Ids follow this order, so that a map read tile

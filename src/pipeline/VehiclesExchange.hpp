@@ -1,0 +1,22 @@
+#pragma once
+// What a rank found of the vehicles (pipeline::ClearVehiclesOnRanks), in bytes for rank 0
+// (docs/scale.md): flat records, no pointers.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "strata/vehicles/VehicleStages.hpp"
+
+namespace strata::pipeline::detail {
+
+/// @brief The blocks a rank cleared and the measured ground columns of their cores.
+[[nodiscard]] std::string EncodeWindows(const std::vector<vehicles::WindowVehicles>& found,
+                                        size_t ground_columns);
+/// @brief One rank's EncodeWindows as one WindowVehicles; its ground columns are added to
+/// `ground_columns`.
+/// @throw FormatError when the bytes are cut short.
+[[nodiscard]] vehicles::WindowVehicles DecodeWindows(const std::string& bytes,
+                                                     size_t& ground_columns);
+
+}  // namespace strata::pipeline::detail
