@@ -188,7 +188,7 @@ bool StoreMatchesMemory(const fs::path& dir, const VoxelMap& memory) {
 // values lazily (delayed loading), and a reader pays for them when it first touches them.
 void TouchValues(const VoxelMap& tile) {
     for (const auto& grid : tile.Grids()) {
-        grid->apply<openvdb::GridTypes>([](const auto& typed) {
+        grid->apply<strata::core::GridTypes>([](const auto& typed) {
             for (auto leaf = typed.tree().cbeginLeaf(); leaf; ++leaf) (void)leaf->buffer().data();
         });
     }

@@ -64,8 +64,9 @@ std::set<TileKey> TilesOf(const openvdb::GridPtrVec& grids, const MapSettings& s
             }
         });
         if (!voxels) {
-            throw InvalidArgumentError("product grid '" + g->getName() + "' has type " + g->type() +
-                                       ", not a stock voxel grid");
+            throw InvalidArgumentError(
+                "product grid '" + g->getName() + "' has type " + g->type() +
+                ", not one of strata's grid types (float, int32, bool, mask, vec3s)");
         }
     }
     return keys;

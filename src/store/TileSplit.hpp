@@ -6,15 +6,14 @@
 #include <map>
 #include <set>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::store::detail {
 
-/// The stock voxel grid types a map or a product may use (OpenVDB's GridTypes without the point
-/// grids, whose instantiation only costs compile time here).
-using VoxelGridTypes =
-    openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<openvdb::BoolGrid,
-                                                                      openvdb::MaskGrid>;
+/// The grid types a map or a product may hold: strata's own (a product of another type is
+/// refused when it is committed, Products.cpp).
+using VoxelGridTypes = core::GridTypes;
 
 /// Moves every leaf of `from` that lies in one of `keys` (every leaf when `keys` is null) into a
 /// grid per tile, which shares `from`'s transform and metadata; every key of `keys` gets a grid.

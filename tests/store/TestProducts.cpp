@@ -140,6 +140,11 @@ TEST(Products, BadKindsRowsAndGridsAreRefusedBeforeAnythingIsWritten) {
     EXPECT_TRUE(refused({"marks", {misaligned}, nullptr, {}}, "not aligned"));
     VoxelMap coarse = VoxelMap::Create(2 * kVoxel);
     EXPECT_TRUE(refused({"marks", {}, &coarse, {}}, "voxel size"));
+    auto doubles = openvdb::DoubleGrid::create(0.0);  // a stock OpenVDB type strata does not use
+    doubles->setName("depth");
+    doubles->setTransform(VoxelMap::MakeTransform(kVoxel));
+    doubles->tree().setValue(openvdb::Coord(0), 1.0);
+    EXPECT_TRUE(refused({"marks", {doubles}, nullptr, {}}, "'depth' has type Tree_double"));
     // A tile that cannot be written (its folder is read-only) fails the whole commit.
     const fs::path tile_dir = (dir / before.tiles.back().file).parent_path();
     fs::permissions(tile_dir, fs::perms::owner_write, fs::perm_options::remove);
