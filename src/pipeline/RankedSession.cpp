@@ -9,6 +9,7 @@
 
 #include "strata/core/Error.hpp"
 #include "strata/integration/UpdateParts.hpp"
+#include "strata/pipeline/Sessions.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -150,12 +151,6 @@ void AddStats(store::WriterStats& sum, const store::WriterStats& s) {
     sum.layers_written += s.layers_written;
     sum.bytes_written += s.bytes_written;
     sum.peak_memory_bytes = std::max(sum.peak_memory_bytes, s.peak_memory_bytes);
-}
-
-json SessionJson(const store::SessionRecord& s) {
-    return {{"id", s.id},          {"name", s.name},     {"commit", s.commit},
-            {"scans", s.scans},    {"points", s.points}, {"start_utc", s.start_utc},
-            {"end_utc", s.end_utc}};
 }
 
 }  // namespace

@@ -6,23 +6,19 @@
 // the candidates are taken in the occupancy tree's order, the lowest voxels in raster order.
 #include "WallsByTiles.hpp"
 
-#include <openvdb/io/Stream.h>
 #include <openvdb/tools/Morphology.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <map>
 #include <set>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "Bytes.hpp"
 #include "TileBudget.hpp"
+#include "WallsKept.hpp"
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/GridBox.hpp"
@@ -85,101 +81,6 @@ void CopyValue(const FromT& from, IntoT& into, const Coord& c) {
     } else {
         into.setValueOff(c, value);
     }
-}
-
-// What the groups leave for the stages after voting, and stage 1's counts.
-struct Kept {
-    core::VoxelMap map;  ///< the candidates' endpoints and labels (no occupancy)
-    openvdb::BoolGrid::Ptr candidates = openvdb::BoolGrid::create(false);
-    /// The voxels seen free within walls::kObservedSideReachVoxels of a candidate: all the later
-    /// stages read of the occupancy, in a BoolGrid's memory.
-    openvdb::BoolGrid::Ptr observed_free = openvdb::BoolGrid::create(false);
-    /// The lowest voxel of an occupied column and its packed endpoints (has_mean 0: none), the
-    /// mean computed for GroundSample's columns only: 20 bytes per column.
-    struct Lowest {
-        int32_t j, i, k;
-        int32_t packed, has_mean;
-    };
-    std::vector<Lowest> lowest;
-    std::vector<std::pair<int32_t, int32_t>> voting_empty;  // voting columns with no voxel
-    CoordBBox occupied;                                     // columns with an occupied voxel
-    size_t occupied_columns = 0, voting_columns = 0;
-};
-
-// Kept over the ranks (docs/scale.md): a rank's Kept in bytes, and merged into rank 0's. The
-// ranks' candidates lie in their own tiles; what two ranks both kept (the occupancy near a
-// border) holds the same values, so the union does not depend on the order of the ranks.
-constexpr const char* kCandidatesGrid = "wall_candidates";
-constexpr const char* kObservedFreeGrid = "observed_free";
-
-std::string Encode(const Kept& k) {
-    std::string out;
-    Put(out, k.occupied_columns);
-    Put(out, k.voting_columns);
-    Put(out, k.occupied.min());
-    Put(out, k.occupied.max());
-    PutVector(out, k.lowest);
-    PutVector(out, k.voting_empty);
-    openvdb::GridPtrVec grids = k.map.Grids();
-    k.candidates->setName(kCandidatesGrid);
-    k.observed_free->setName(kObservedFreeGrid);
-    grids.push_back(k.candidates);
-    grids.push_back(k.observed_free);
-    std::ostringstream os(std::ios_base::binary);
-    openvdb::io::Stream(os).write(grids);
-    return out + os.str();
-}
-
-// Copies every voxel `from` holds (active, or inactive with a value of its own) into `into`.
-template <typename GridT>
-void MergeVoxels(const GridT& from, GridT& into) {
-    const auto background = from.background();
-    auto acc = into.getAccessor();
-    for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {
-        for (auto v = leaf->cbeginValueAll(); v; ++v) {
-            if (v.isValueOn()) {
-                acc.setValueOn(v.getCoord(), *v);
-            } else if (*v != background) {
-                acc.setValueOff(v.getCoord(), *v);
-            }
-        }
-    }
-    for (auto it = from.tree().cbeginValueOn(); it; ++it) {
-        if (!it.isVoxelValue()) into.tree().fill(it.getBoundingBox(), *it, true);
-    }
-}
-
-void Merge(const std::string& bytes, Kept& into) {
-    Reader in(bytes, "walls");
-    into.occupied_columns += in.Get<size_t>();
-    into.voting_columns += in.Get<size_t>();
-    const Coord lo = in.Get<Coord>(), hi = in.Get<Coord>();
-    if (!CoordBBox(lo, hi).empty()) {
-        into.occupied.expand(lo);
-        into.occupied.expand(hi);
-    }
-    for (const Kept::Lowest& l : in.GetVector<Kept::Lowest>()) into.lowest.push_back(l);
-    for (const auto& e : in.GetVector<std::pair<int32_t, int32_t>>()) {
-        into.voting_empty.push_back(e);
-    }
-    std::istringstream is(in.Rest(), std::ios_base::binary);
-    openvdb::io::Stream stream(is, /*delayLoad=*/false);
-    openvdb::GridPtrVec grids = *stream.getGrids();
-    for (const auto& [wanted, to] : {std::pair{kCandidatesGrid, into.candidates},
-                                     std::pair{kObservedFreeGrid, into.observed_free}}) {
-        // A structured binding cannot be captured before C++20 (clang refuses it).
-        const std::string name = wanted;
-        const auto it = std::find_if(grids.begin(), grids.end(),
-                                     [&](const auto& g) { return g->getName() == name; });
-        const auto grid =
-            it == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::BoolGrid>(*it);
-        if (!grid) throw FormatError(std::string("walls: a rank's answer has no ") + name);
-        MergeVoxels(*grid, *to);
-        grids.erase(it);
-    }
-    const core::VoxelMap map = core::VoxelMap::FromGrids(grids);
-    MergeVoxels(*map.label, *into.map.label);
-    MergeVoxels(*map.endpoints, *into.map.endpoints);
 }
 
 class Groups {
@@ -247,7 +148,7 @@ private:
 // Stage 1 on one group of tiles read with its halo; its results go into `kept`.
 void CollectGroup(const store::TileReader& reader, const store::MapSettings& settings,
                   const std::vector<TileKey>& group, const Groups& groups, int halo,
-                  const walls::WallConfig& config, Kept& kept) {
+                  const walls::WallConfig& config, WallsKept& kept) {
     const std::set<TileKey> in(group.begin(), group.end());
     core::VoxelMap g = reader.LoadFused(group);
     std::set<TileKey> neighbours;
@@ -366,7 +267,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
         groups.Split(ShareOfRank(groups, memory_budget_bytes, ranks.size()), map.dir().string());
     // Nothing cached: each group is read, voted on and dropped.
     const store::TileReader reader(map, snapshot, 0);
-    Kept kept;
+    WallsKept kept;
     kept.map = map.EmptyMap();
     size_t mine = 0;
     OnEveryRank(ranks, [&] {
@@ -377,14 +278,14 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
         }
     });
     if (ranks.size() > 1) {
-        const std::vector<std::string> all = ranks.Gather(ranks.root() ? "" : Encode(kept));
+        const std::vector<std::string> all = ranks.Gather(ranks.root() ? "" : EncodeKept(kept));
         if (!ranks.root()) {
             WallsOutcome outcome;
             outcome.commit = snapshot.commit;
             outcome.tile_groups = mine;
             return outcome;
         }
-        for (size_t r = 1; r < all.size(); ++r) Merge(all[r], kept);
+        for (size_t r = 1; r < all.size(); ++r) MergeKept(all[r], kept);
     }
 
     walls::WallResult voted;
@@ -395,7 +296,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
         voted.stats.voting_columns += kept.occupied.isInside(Coord(i, j, 0));
     }
     size_t kept_bytes = kept.candidates->memUsage() + kept.observed_free->memUsage() +
-                        kept.lowest.capacity() * sizeof(Kept::Lowest) +
+                        kept.lowest.capacity() * sizeof(WallsKept::Lowest) +
                         kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
     for (const auto& grid : kept.map.Grids()) kept_bytes += grid->memUsage();
     std::sort(kept.lowest.begin(), kept.lowest.end(),
@@ -403,7 +304,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     // The means of the sample only, as VoxelMap::PointMean computes them.
     std::vector<Eigen::Vector3d> lowest;
     for (size_t n : walls::GroundSample(kept.lowest.size())) {
-        const Kept::Lowest& l = kept.lowest[n];
+        const WallsKept::Lowest& l = kept.lowest[n];
         const Eigen::Vector3d centre = kept.map.VoxelCenter(Coord(l.i, l.j, l.k));
         lowest.push_back(l.has_mean ? centre + core::endpoint::Offset(l.packed, kept.map.voxel_size)
                                     : centre);

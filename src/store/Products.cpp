@@ -58,7 +58,7 @@ void RequireRows(const std::vector<std::string>& rows, const detail::Database& d
 std::set<TileKey> TilesOf(const openvdb::GridPtrVec& grids, const MapSettings& settings) {
     std::set<TileKey> keys;
     for (const auto& g : grids) {
-        const bool voxels = g->apply<detail::VoxelGridTypes>([&](const auto& typed) {
+        const bool voxels = g->apply<core::GridTypes>([&](const auto& typed) {
             for (auto leaf = typed.tree().cbeginLeaf(); leaf; ++leaf) {
                 keys.insert(settings.TileOf(leaf->origin()));
             }
@@ -116,7 +116,7 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
     // Each grid cut into its tiles once, leaf by leaf (tile edges fall on leaf edges).
     std::map<TileKey, openvdb::GridPtrVec> by_tile;
     for (const auto& g : product.grids) {
-        g->apply<detail::VoxelGridTypes>([&](const auto& typed) {
+        g->apply<core::GridTypes>([&](const auto& typed) {
             auto copy = typed.deepCopy();
             copy->tree().voxelizeActiveTiles();
             for (auto& [key, piece] : detail::StealTiles(*copy, impl.settings, &keys)) {

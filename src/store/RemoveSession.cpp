@@ -60,7 +60,7 @@ void Rebuild(core::VoxelMap& tile, const SessionLayer& removed,
     }
     for (const auto& grid : tile.Grids()) {
         if (grid == tile.occupancy) continue;
-        grid->apply<detail::VoxelGridTypes>([&](auto& typed) {
+        grid->apply<core::GridTypes>([&](auto& typed) {
             auto acc = typed.getAccessor();
             for (const openvdb::Coord& ijk : emptied) acc.setValueOff(ijk, typed.background());
         });

@@ -24,7 +24,7 @@ std::map<TileKey, core::VoxelMap> StealMapTiles(core::VoxelMap& work, const MapS
     std::vector<std::map<TileKey, openvdb::GridBase::Ptr>> pieces(grids.size());
     std::set<TileKey> all;
     for (size_t g = 0; g < grids.size(); ++g) {
-        grids[g]->apply<VoxelGridTypes>([&](auto& typed) {
+        grids[g]->apply<core::GridTypes>([&](auto& typed) {
             for (auto& [key, piece] : StealTiles(typed, settings, keys)) {
                 pieces[g][key] = piece;
                 all.insert(key);
@@ -49,7 +49,7 @@ void MergeMap(core::VoxelMap& into, core::VoxelMap& tile) {
     const openvdb::GridPtrVec targets = into.Grids();
     for (const auto& from : tile.Grids()) {
         const openvdb::GridBase::Ptr target = Named(targets, from->getName());
-        target->apply<VoxelGridTypes>([&](auto& typed) {
+        target->apply<core::GridTypes>([&](auto& typed) {
             using GridT = std::decay_t<decltype(typed)>;
             auto source = openvdb::gridPtrCast<GridT>(from);
             if (!source) {
@@ -63,13 +63,13 @@ void MergeMap(core::VoxelMap& into, core::VoxelMap& tile) {
 
 void VoxelizeTiles(core::VoxelMap& map) {
     for (const auto& g : map.Grids()) {
-        g->apply<VoxelGridTypes>([](auto& typed) { typed.tree().voxelizeActiveTiles(); });
+        g->apply<core::GridTypes>([](auto& typed) { typed.tree().voxelizeActiveTiles(); });
     }
 }
 
 void PruneInactive(core::VoxelMap& map) {
     for (const auto& g : map.Grids()) {
-        g->apply<VoxelGridTypes>([](auto& typed) { openvdb::tools::pruneInactive(typed.tree()); });
+        g->apply<core::GridTypes>([](auto& typed) { openvdb::tools::pruneInactive(typed.tree()); });
     }
 }
 

@@ -11,10 +11,6 @@
 
 namespace strata::store::detail {
 
-/// The grid types a map or a product may hold: strata's own (a product of another type is
-/// refused when it is committed, Products.cpp).
-using VoxelGridTypes = core::GridTypes;
-
 /// Moves every leaf of `from` that lies in one of `keys` (every leaf when `keys` is null) into a
 /// grid per tile, which shares `from`'s transform and metadata; every key of `keys` gets a grid.
 /// Active tiles above leaf level must not exist (VoxelizeTiles).

@@ -1,0 +1,95 @@
+// walls' stage 1 per group of tiles keeps a WallsKept; under mpirun each rank sends its own to
+// rank 0 as bytes: the counts and columns as flat records (Bytes.hpp), the grids as one OpenVDB
+// stream.
+#include "WallsKept.hpp"
+
+#include <openvdb/io/Stream.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "Bytes.hpp"
+#include "strata/core/Error.hpp"
+
+namespace strata::pipeline::detail {
+namespace {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+
+constexpr const char* kCandidatesGrid = "wall_candidates";
+constexpr const char* kObservedFreeGrid = "observed_free";
+
+// Copies every voxel `from` holds (active, or inactive with a value of its own) into `into`.
+template <typename GridT>
+void MergeVoxels(const GridT& from, GridT& into) {
+    const auto background = from.background();
+    auto acc = into.getAccessor();
+    for (auto leaf = from.tree().cbeginLeaf(); leaf; ++leaf) {
+        for (auto v = leaf->cbeginValueAll(); v; ++v) {
+            if (v.isValueOn()) {
+                acc.setValueOn(v.getCoord(), *v);
+            } else if (*v != background) {
+                acc.setValueOff(v.getCoord(), *v);
+            }
+        }
+    }
+    for (auto it = from.tree().cbeginValueOn(); it; ++it) {
+        if (!it.isVoxelValue()) into.tree().fill(it.getBoundingBox(), *it, true);
+    }
+}
+
+}  // namespace
+
+std::string EncodeKept(const WallsKept& k) {
+    std::string out;
+    Put(out, k.occupied_columns);
+    Put(out, k.voting_columns);
+    Put(out, k.occupied.min());
+    Put(out, k.occupied.max());
+    PutVector(out, k.lowest);
+    PutVector(out, k.voting_empty);
+    openvdb::GridPtrVec grids = k.map.Grids();
+    k.candidates->setName(kCandidatesGrid);
+    k.observed_free->setName(kObservedFreeGrid);
+    grids.push_back(k.candidates);
+    grids.push_back(k.observed_free);
+    std::ostringstream os(std::ios_base::binary);
+    openvdb::io::Stream(os).write(grids);
+    return out + os.str();
+}
+
+void MergeKept(const std::string& bytes, WallsKept& into) {
+    Reader in(bytes, "walls");
+    into.occupied_columns += in.Get<size_t>();
+    into.voting_columns += in.Get<size_t>();
+    const Coord lo = in.Get<Coord>(), hi = in.Get<Coord>();
+    if (!CoordBBox(lo, hi).empty()) {
+        into.occupied.expand(lo);
+        into.occupied.expand(hi);
+    }
+    for (const WallsKept::Lowest& l : in.GetVector<WallsKept::Lowest>()) into.lowest.push_back(l);
+    for (const auto& e : in.GetVector<std::pair<int32_t, int32_t>>()) {
+        into.voting_empty.push_back(e);
+    }
+    std::istringstream is(in.Rest(), std::ios_base::binary);
+    openvdb::io::Stream stream(is, /*delayLoad=*/false);
+    openvdb::GridPtrVec grids = *stream.getGrids();
+    for (const auto& [wanted, to] : {std::pair{kCandidatesGrid, into.candidates},
+                                     std::pair{kObservedFreeGrid, into.observed_free}}) {
+        // A structured binding cannot be captured before C++20 (clang refuses it).
+        const std::string name = wanted;
+        const auto it = std::find_if(grids.begin(), grids.end(),
+                                     [&](const auto& g) { return g->getName() == name; });
+        const auto grid =
+            it == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::BoolGrid>(*it);
+        if (!grid) throw FormatError(std::string("walls: a rank's answer has no ") + name);
+        MergeVoxels(*grid, *to);
+        grids.erase(it);
+    }
+    const core::VoxelMap map = core::VoxelMap::FromGrids(grids);
+    MergeVoxels(*map.label, *into.map.label);
+    MergeVoxels(*map.endpoints, *into.map.endpoints);
+}
+
+}  // namespace strata::pipeline::detail

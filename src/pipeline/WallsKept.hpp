@@ -1,0 +1,43 @@
+#pragma once
+// What walls' stage 1 keeps of each group of tiles for the later stages (pipeline's
+// FindWallsByTiles), and its rank encoding for rank 0 (docs/scale.md).
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "strata/core/GridTypes.hpp"
+#include "strata/core/VoxelMap.hpp"
+
+namespace strata::pipeline::detail {
+
+/// @brief What the groups leave for the stages after voting, and stage 1's counts.
+struct WallsKept {
+    core::VoxelMap map;  ///< the candidates' endpoints and labels (no occupancy)
+    openvdb::BoolGrid::Ptr candidates = openvdb::BoolGrid::create(false);
+    /// The voxels seen free within walls::kObservedSideReachVoxels of a candidate: all the later
+    /// stages read of the occupancy, in a BoolGrid's memory.
+    openvdb::BoolGrid::Ptr observed_free = openvdb::BoolGrid::create(false);
+    /// The lowest voxel of an occupied column and its packed endpoints (has_mean 0: none), the
+    /// mean computed for GroundSample's columns only: 20 bytes per column.
+    struct Lowest {
+        int32_t j, i, k;
+        int32_t packed, has_mean;
+    };
+    std::vector<Lowest> lowest;
+    std::vector<std::pair<int32_t, int32_t>> voting_empty;  // voting columns with no voxel
+    openvdb::CoordBBox occupied;                            // columns with an occupied voxel
+    size_t occupied_columns = 0, voting_columns = 0;
+};
+
+/// @brief A rank's WallsKept in bytes.
+[[nodiscard]] std::string EncodeKept(const WallsKept& kept);
+/// @brief Adds one rank's EncodeKept to rank 0's. The ranks' candidates lie in their own tiles;
+/// what two ranks both kept (the occupancy near a border) holds the same values, so the union
+/// does not depend on the order of the ranks.
+/// @throw FormatError when the bytes are cut short or lack a grid.
+void MergeKept(const std::string& bytes, WallsKept& into);
+
+}  // namespace strata::pipeline::detail
