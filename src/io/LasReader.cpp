@@ -1,5 +1,4 @@
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -99,10 +98,7 @@ LasHeader ReadLasHeader(const std::filesystem::path& path) {
 
 core::Scan ReadLas(const std::filesystem::path& path, const ReadOptions& options) {
     const std::string file = path.string();
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-    if (ext == ".laz") RefuseLaz(file);
+    if (LowerExtension(path) == ".laz") RefuseLaz(file);
     const std::vector<uint8_t> bytes = detail::ReadFileBytes(path);
     detail::BinaryCursor cursor(bytes.data(), bytes.size(), file);
     const LasHeader h = ParseLasHeader(cursor, bytes.size());

@@ -5,7 +5,6 @@
 #include <openvdb/tools/Count.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -16,6 +15,7 @@
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/io/AtomicFile.hpp"
+#include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
 namespace {
@@ -23,13 +23,6 @@ namespace {
 // OctoMap's default clamping, [0.12, 0.97] in probability; widened only when the map needs it.
 constexpr double kDefaultClampMinLogOdds = -2.0;
 constexpr double kDefaultClampMaxLogOdds = 3.5;
-
-std::string LowerExtension(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
 
 void CheckExtent(const core::VoxelMap& map, const std::filesystem::path& path) {
     const openvdb::CoordBBox bbox = map.occupancy->evalActiveVoxelBoundingBox();

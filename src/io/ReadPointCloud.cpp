@@ -7,16 +7,12 @@
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::io {
-namespace {
-
 std::string LowerExtension(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
     return ext;
 }
-
-}  // namespace
 
 core::Scan ReadPointCloud(const std::filesystem::path& path, const ReadOptions& options) {
     const std::string ext = LowerExtension(path);

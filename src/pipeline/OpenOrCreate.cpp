@@ -1,22 +1,11 @@
 #include "strata/pipeline/OpenOrCreate.hpp"
 
-#include <cctype>
 #include <cmath>
 
 #include "strata/core/Error.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
 namespace strata::pipeline {
-
-namespace {
-
-bool IsLas(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".las";
-}
-
-}  // namespace
 
 store::StoreSettings NewMapSettings(const MapRequest& request) {
     request.rule.Validate();
@@ -26,7 +15,8 @@ store::StoreSettings NewMapSettings(const MapRequest& request) {
     settings.integration = request.rule.ForNewMap();  // recorded: every later session fuses alike
     if (request.origin) {
         settings.origin = *request.origin;
-    } else if (!request.georeference_from.empty() && IsLas(request.georeference_from)) {
+    } else if (!request.georeference_from.empty() &&
+               io::LowerExtension(request.georeference_from) == ".las") {
         settings.origin = io::ReadLasHeader(request.georeference_from).min.array().floor().matrix();
     }
     return settings;

@@ -337,6 +337,19 @@ TEST(TextReader, ReadsRealOctomapScan) {
 
 // ---------------------------------------------------------------- robustness
 
+TEST(PointCloudReaders, ChooseTheFormatByItsExtensionInAnyCase) {
+    EXPECT_EQ(LowerExtension("scan.PCD"), ".pcd");
+    EXPECT_EQ(LowerExtension("dir.v2/Tile.Las"), ".las");
+    EXPECT_EQ(LowerExtension("n015-LIDAR_TOP.pcd.bin"), ".bin");
+    EXPECT_EQ(LowerExtension("no_extension"), "");
+    TempDir dir;
+    WriteFile(dir / "UPPER.PCD", MakePcd("ascii"));
+    ExpectRefCloud(ReadPointCloud(dir / "UPPER.PCD"), {0, 2, 4, 5});
+    WriteFile(dir / "scan.xyzw", "1 2 3\n");
+    ExpectReadError([&] { return ReadPointCloud(dir / "scan.xyzw"); }, dir / "scan.xyzw",
+                    "unknown point cloud extension '.xyzw'");
+}
+
 TEST(PointCloudReaders, ReportEveryTruncationOfBinaryFiles) {
     TempDir dir;
     const std::vector<std::pair<std::string, std::string>> files = {

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include "strata/core/Labels.hpp"
 #include "strata/core/Scan.hpp"
@@ -20,6 +21,10 @@ struct ReadOptions {
     /// when exactly one of 4 and 5 divides it (ReadBin refuses the file when both or neither do).
     int bin_fields = 0;
 };
+
+/// @brief The file's extension in lower case, dot included ("scan.PCD" -> ".pcd", "" without
+/// one): how the readers and exporters choose a format.
+[[nodiscard]] std::string LowerExtension(const std::filesystem::path& path);
 
 /// @brief Reads a point cloud chosen by extension: .pcd, .ply, .las, raw float32 .bin (KITTI,
 /// nuScenes .pcd.bin), text (.txt .xyz .csv .dat) and bzip2-compressed text (any name ending in
