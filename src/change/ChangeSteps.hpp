@@ -3,11 +3,10 @@
 // (ChangeDetection.cpp) and the tile-by-tile one (TiledChanges.cpp), so that both give the same
 // answer.
 
-#include <openvdb/openvdb.h>
-
 #include <cstddef>
 
 #include "strata/change/ChangeDetection.hpp"
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::change::detail {
 

@@ -1,7 +1,5 @@
 #include "strata/geometry/Clustering.hpp"
 
-#include <openvdb/openvdb.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +8,7 @@
 #include <utility>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::geometry {
 

@@ -1,8 +1,8 @@
 #include "strata/geometry/Grouping.hpp"
 
-#include <openvdb/openvdb.h>
-
 #include <deque>
+
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::geometry {
 

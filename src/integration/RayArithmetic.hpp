@@ -6,8 +6,6 @@
 // algorithm at full precision, for coordinates beyond OctoMap's key range. The module compiles
 // with -ffp-contract=off: a fused multiply-add would round the float sums differently.
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
@@ -15,6 +13,7 @@
 #include <type_traits>
 
 #include "RayMarking.hpp"
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::integration::detail {
 

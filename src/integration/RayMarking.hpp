@@ -2,13 +2,12 @@
 // Private to the integrator: which voxels one scan saw free and occupied (ARCHITECTURE.md,
 // "Integration semantics"), marked into per-thread bitmaps over the scan's bounding box.
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/integration/IntegrationConfig.hpp"
 
 namespace strata::integration::detail {

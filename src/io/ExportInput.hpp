@@ -1,12 +1,11 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <filesystem>
 #include <stdexcept>
 #include <string>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/core/VoxelMap.hpp"
 

@@ -3,11 +3,12 @@
 // The one place the vehicles module talks to Embree (STYLE.md F): the map's surfaces as voxel
 // cubes, built once, queried from many threads.
 #include <embree3/rtcore.h>
-#include <openvdb/openvdb.h>
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
+
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::vehicles::detail {
 

@@ -1,12 +1,11 @@
 #pragma once
 // The pieces walls are made of (private to the walls module): the accepted parts before merging
 // and the measurements the merge and the wall tests take of them.
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <numeric>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/geometry/PlaneFit.hpp"

@@ -1,10 +1,10 @@
 // `strata diff` through the program: a room mapped twice, the second time with a pillar in it.
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
 
 #include <nlohmann/json.hpp>
 
 #include "CliTestUtil.hpp"
+#include "strata/core/GridTypes.hpp"
 #include "strata/io/Image.hpp"
 
 namespace strata::tools::test {

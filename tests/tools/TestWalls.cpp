@@ -1,13 +1,13 @@
 // `strata walls` through the program, on the first scans of the simulated street (a facade
 // leaning 4 degrees towards the street at x 22-38 m, y -9 m).
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
 #include <sqlite3.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
 #include "CliTestUtil.hpp"
+#include "strata/core/GridTypes.hpp"
 #include "strata/io/Image.hpp"
 #include "strata/store/MapStore.hpp"
 

@@ -1,12 +1,11 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/core/OccupancyMasks.hpp"
 #include "strata/core/Region.hpp"

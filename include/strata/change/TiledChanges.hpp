@@ -2,12 +2,11 @@
 // Change queries read tile by tile (docs/change.md, "Tile by tile"): the answer of DetectChanges
 // over the whole map, with a few tiles in memory at a time.
 
-#include <openvdb/openvdb.h>
-
 #include <functional>
 #include <vector>
 
 #include "strata/change/ChangeDetection.hpp"
+#include "strata/core/GridTypes.hpp"
 #include "strata/store/Snapshot.hpp"
 
 namespace strata::change {

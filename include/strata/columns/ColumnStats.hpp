@@ -1,11 +1,10 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/core/VoxelMap.hpp"
 

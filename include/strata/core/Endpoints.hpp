@@ -1,9 +1,9 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <cstdint>
+
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::core {
 

@@ -3,9 +3,9 @@
 // box with the background, which for the boxes tiles use (unbounded in z) builds and prunes
 // nodes across the whole index range: seconds per call. These touch only the leaves there are.
 
-#include <openvdb/openvdb.h>
-
 #include <vector>
+
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::core {
 

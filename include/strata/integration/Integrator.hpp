@@ -1,10 +1,9 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <cstddef>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/Scan.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/integration/IntegrationConfig.hpp"

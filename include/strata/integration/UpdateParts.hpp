@@ -2,12 +2,11 @@
 // Parts of a scan update, for processes that own some tiles of a map each (docs/scale.md): the
 // one that computed an update keeps or sends each part to the process that applies it.
 
-#include <openvdb/openvdb.h>
-
 #include <functional>
 #include <string>
 #include <string_view>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/integration/Integrator.hpp"
 
 namespace strata::integration {

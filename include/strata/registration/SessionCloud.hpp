@@ -1,10 +1,9 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/Scan.hpp"
 
 namespace strata::registration {

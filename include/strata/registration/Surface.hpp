@@ -1,11 +1,10 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Geometry>
 #include <optional>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/registration/RegistrationConfig.hpp"
 

@@ -1,12 +1,11 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/store/Snapshot.hpp"
 

@@ -1,12 +1,11 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/integration/IntegrationConfig.hpp"
 
 namespace strata::store {

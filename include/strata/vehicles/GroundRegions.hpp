@@ -1,13 +1,12 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <cstdint>
 #include <map>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/vehicles/GroundField.hpp"
 

@@ -1,14 +1,13 @@
 #pragma once
 
 // The stages of ClearVehicles, public so that each can be tested on geometry with a known answer.
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Geometry>
 #include <memory>
 #include <utility>
 #include <vector>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/GridTypes.hpp"
 #include "strata/vehicles/Vehicles.hpp"
 
 namespace strata::vehicles {

@@ -1,11 +1,10 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/vehicles/GroundField.hpp"
 #include "strata/vehicles/LShapeFit.hpp"

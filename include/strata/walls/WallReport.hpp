@@ -1,11 +1,10 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Core>
 #include <filesystem>
 #include <string>
 
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/walls/Walls.hpp"
 

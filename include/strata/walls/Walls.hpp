@@ -1,13 +1,12 @@
 #pragma once
 
-#include <openvdb/openvdb.h>
-
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "strata/columns/ColumnStats.hpp"
+#include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
 #include "strata/walls/Slant.hpp"
 

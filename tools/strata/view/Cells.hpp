@@ -3,12 +3,12 @@
 // attributes the page colours by, in a compact binary form (docs/viewer.md, "Tile format").
 // Pure functions of grids: no store, no HTTP, so they can move into `pipeline` unchanged.
 
-#include <openvdb/openvdb.h>
-
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "strata/core/GridTypes.hpp"
 
 namespace strata::view {
 
