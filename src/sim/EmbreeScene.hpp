@@ -42,7 +42,7 @@ public:
     [[nodiscard]] float ClosestDistance(const Eigen::Vector3f& point, float max_radius) const;
 
 private:
-    [[noreturn]] void Fail(const std::string& what);  // releases, then throws runtime_error
+    [[noreturn]] void Fail(const std::string& what);  // releases, then throws strata::Error
     void Release() noexcept;
 
     RTCDevice device_ = nullptr;

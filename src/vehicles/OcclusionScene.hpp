@@ -32,7 +32,7 @@ public:
     [[nodiscard]] size_t faces() const { return faces_; }
 
 private:
-    [[noreturn]] void Fail(const std::string& what);  // releases, then throws runtime_error
+    [[noreturn]] void Fail(const std::string& what);  // releases, then throws strata::Error
     void Release() noexcept;
 
     RTCDevice device_ = nullptr;

@@ -84,17 +84,17 @@ void Run(const DiffArgs& args) {
     if (args.list) return List(args);
     const bool scans = !args.to_kitti.empty() || !args.to_scans.empty();
     if (!args.to_kitti.empty() && !args.to_scans.empty()) {
-        throw std::invalid_argument("give at most one of --to-kitti and --to-scans");
+        throw InvalidArgumentError("give at most one of --to-kitti and --to-scans");
     }
     if (scans == !args.to.empty()) {
-        throw std::invalid_argument("give exactly one of --to SIDE, --to-kitti SEQ, --to-scans");
+        throw InvalidArgumentError("give exactly one of --to SIDE, --to-kitti SEQ, --to-scans");
     }
-    if (args.from.empty() && !scans) throw std::invalid_argument("--from SIDE is required");
-    if (args.memory_budget_mb < 0.0) throw std::invalid_argument("--memory-budget must be >= 0");
-    if (args.min_voxels < 1) throw std::invalid_argument("--min-voxels must be at least 1");
-    if (args.gap < 0) throw std::invalid_argument("--gap must be >= 0");
+    if (args.from.empty() && !scans) throw InvalidArgumentError("--from SIDE is required");
+    if (args.memory_budget_mb < 0.0) throw InvalidArgumentError("--memory-budget must be >= 0");
+    if (args.min_voxels < 1) throw InvalidArgumentError("--min-voxels must be at least 1");
+    if (args.gap < 0) throw InvalidArgumentError("--gap must be >= 0");
     if (args.tolerance < 0 || args.margin < 0 || args.grow < 0 || args.support < 0) {
-        throw std::invalid_argument("--tolerance, --margin, --grow and --support must be >= 0");
+        throw InvalidArgumentError("--tolerance, --margin, --grow and --support must be >= 0");
     }
 
     change::ChangeQuery query;
