@@ -22,9 +22,9 @@ if(STRATA_BUILD_FUZZ AND STRATA_SANITIZE)
   message(FATAL_ERROR "STRATA_BUILD_FUZZ builds with ASan + UBSan already; "
                       "STRATA_SANITIZE=${STRATA_SANITIZE} needs a build directory of its own")
 elseif(STRATA_BUILD_FUZZ)
-  # Coverage for libFuzzer on everything; only the fuzz targets link libFuzzer's main
-  # (-fsanitize=fuzzer, tests/fuzz/CMakeLists.txt), so the same objects make the test binaries
-  # of the ASan + UBSan run too. The ignorelist gives the reason for each entry. Its path is
+  # ASan + UBSan on everything; libFuzzer's coverage only on the libraries the fuzz targets run
+  # (tests/fuzz/CMakeLists.txt), and only the fuzz targets link libFuzzer's main
+  # (-fsanitize=fuzzer), so the same objects make the test binaries of the ASan + UBSan run too. The ignorelist gives the reason for each entry. Its path is
   # relative to the build directory, where Ninja runs the compiler: ccache hashes the flag as
   # written, and an absolute path would differ between clones. ccache does not read the file,
   # so its checksum goes into a definition: a changed ignorelist recompiles everything.
@@ -32,7 +32,7 @@ elseif(STRATA_BUILD_FUZZ)
   file(RELATIVE_PATH ignorelist_relative ${PROJECT_BINARY_DIR} ${ignorelist})
   file(MD5 ${ignorelist} ignorelist_md5)
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${ignorelist})
-  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined
+  add_compile_options(-fsanitize=address,undefined
                       -fno-sanitize-recover=undefined -fno-omit-frame-pointer
                       -fsanitize-ignorelist=${ignorelist_relative}
                       -Wno-unknown-warning-option)  # cmake/Warnings.cmake has gcc's -Wshadow=local
