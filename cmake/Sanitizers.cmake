@@ -24,7 +24,8 @@ if(STRATA_BUILD_FUZZ AND STRATA_SANITIZE)
 elseif(STRATA_BUILD_FUZZ)
   # ASan + UBSan on everything; libFuzzer's coverage only on the libraries the fuzz targets run
   # (tests/fuzz/CMakeLists.txt), and only the fuzz targets link libFuzzer's main
-  # (-fsanitize=fuzzer), so the same objects make the test binaries of the ASan + UBSan run too. The ignorelist gives the reason for each entry. Its path is
+  # (-fsanitize=fuzzer), so the same objects make the test binaries of the ASan + UBSan run
+  # too. The ignorelist gives the reason for each entry. Its path is
   # relative to the build directory, where Ninja runs the compiler: ccache hashes the flag as
   # written, and an absolute path would differ between clones. ccache does not read the file,
   # so its checksum goes into a definition: a changed ignorelist recompiles everything.
