@@ -10,5 +10,6 @@ strata_set_warnings(bench_store)
 # docs/bench.md (bench/run_benchmarks.sh).
 if(STRATA_BUILD_TESTS)
   add_test(NAME bench_store_short COMMAND bench_store --short)
-  set_tests_properties(bench_store_short PROPERTIES RUN_SERIAL TRUE TIMEOUT 900 LABELS bench)
+  set_tests_properties(bench_store_short PROPERTIES RUN_SERIAL TRUE TIMEOUT 900 LABELS bench
+                       COST 18)  # seconds on 2026-12-04 (tests/TestCosts.cmake)
 endif()

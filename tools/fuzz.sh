@@ -4,6 +4,7 @@
 # report, a hang (-timeout) or runaway memory (-rss_limit_mb). docs/reliability.md, "Fuzzing".
 # Usage: tools/fuzz.sh [SECONDS_PER_TARGET]   (default 20)
 #   STRATA_FUZZ_TARGETS="pcd ply"  only these targets     STRATA_BUILD_JOBS=2  build parallelism
+#   STRATA_FUZZ_JOBS=1  targets run at once (default: one per core)
 # Corpora grow in build-fuzz/corpus/<target>/ across runs; crash inputs land in
 # build-fuzz/artifacts/, each target's output in build-fuzz/logs/<target>.log.
 set -euo pipefail
@@ -34,21 +35,34 @@ mkdir -p "$build/corpus" "$build/artifacts" "$build/logs"
 # Leak checking is off: OpenVDB and TBB keep process-lifetime allocations that are not bugs.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
-failed=()
-printf '%-9s %8s %12s %8s  %s\n' target seconds execs corpus result
-for t in "${targets[@]}"; do
-  corpus="$build/corpus/$t"
+# Each target runs on one core for SECONDS; as many run at once as there are cores
+# (STRATA_FUZZ_JOBS), so a target's search is the same as alone and the step takes a share of
+# the time.
+parallel=${STRATA_FUZZ_JOBS:-$(nproc)}
+Fuzz() {  # Fuzz TARGET: runs it; its log in logs/, its verdict in logs/TARGET.result.
+  local t=$1 corpus="$build/corpus/$1" log="$build/logs/$1.log" result=ok
   mkdir -p "$corpus"
-  dirs=("$corpus" "$build/seeds/$t")
+  local dirs=("$corpus" "$build/seeds/$t")
   [[ -d "$root/tests/fuzz/seeds/$t" ]] && dirs+=("$root/tests/fuzz/seeds/$t")
-  log="$build/logs/$t.log"
-  result=ok
   "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -max_len="${max_len[$t]}" \
     -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
     -artifact_prefix="$build/artifacts/$t-" "${dirs[@]}" >"$log" 2>&1 || result=FAILED
+  echo "$result" >"$build/logs/$t.result"
+}
+for t in "${targets[@]}"; do
+  rm -f "$build/logs/$t.result"
+  while (($(jobs -rp | wc -l) >= parallel)); do wait -n || true; done
+  Fuzz "$t" &
+done
+wait
+failed=()
+printf '%-9s %8s %12s %8s  %s\n' target seconds execs corpus result
+for t in "${targets[@]}"; do
+  log="$build/logs/$t.log"
+  result=$(cat "$build/logs/$t.result" 2>/dev/null || echo FAILED)
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   printf '%-9s %8s %12s %8s  %s\n' "$t" "$seconds" "${execs:-?}" \
-    "$(find "$corpus" -type f | wc -l)" "$result"
+    "$(find "$build/corpus/$t" -type f | wc -l)" "$result"
   if [[ $result != ok ]]; then
     failed+=("$t")
     grep -m3 -E 'ERROR: |runtime error|SUMMARY' "$log" | sed 's/^/    /' || true
