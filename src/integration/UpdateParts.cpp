@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <type_traits>
 
 #include "strata/core/Error.hpp"
@@ -12,6 +13,10 @@ namespace {
 using MaskLeaf = openvdb::MaskTree::LeafNodeType;
 constexpr uint32_t kMagic = 0x31555453;  // "STU1": strata update, version 1
 constexpr size_t kMaskWords = MaskLeaf::NodeMaskType::WORD_COUNT;
+// A leaf's record: its origin (three int32) and its mask words, packed.
+constexpr size_t kLeafBytes = 3 * sizeof(int32_t) + kMaskWords * sizeof(uint64_t);
+// An endpoint group's record: voxel, points, class, offset sum.
+constexpr size_t kGroupBytes = 4 * sizeof(int32_t) + 1 + 3 * sizeof(double);
 
 openvdb::MaskTree::Ptr SelectLeaves(const openvdb::MaskTree& tree, const LeafFilter& keep) {
     auto out = std::make_shared<openvdb::MaskTree>();
@@ -29,20 +34,41 @@ openvdb::Coord LeafOrigin(const openvdb::Coord& ijk) {
 // x86-64 and ARM64 only; the magic number refuses anything else).
 class UpdateWriter {
 public:
+    explicit UpdateWriter(size_t reserve) { bytes_.reserve(reserve); }
+
     template <typename T>
     void Put(const T& value) {
         static_assert(std::is_trivially_copyable_v<T>);
         bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
     }
-    void PutTree(const openvdb::MaskTree& tree) {
-        Put(static_cast<uint64_t>(tree.leafCount()));
+    // A count written once its records are: PutCount(), the records, SetCount(at, n).
+    size_t PutCount() {
+        Put(uint64_t{0});
+        return bytes_.size() - sizeof(uint64_t);
+    }
+    void SetCount(size_t at, uint64_t count) {
+        std::memcpy(bytes_.data() + at, &count, sizeof(count));
+    }
+    // The leaves `keep` accepts (every leaf without a filter): their count, then each one's
+    // origin and mask words, appended as one record.
+    void PutTree(const openvdb::MaskTree& tree, const LeafFilter& keep) {
+        const size_t count_at = PutCount();
+        uint64_t count = 0;
+        char record[kLeafBytes];
         for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
-            Put(leaf->origin().x());
-            Put(leaf->origin().y());
-            Put(leaf->origin().z());
+            const openvdb::Coord& o = leaf->origin();
+            if (keep && !keep(o)) continue;
+            const int32_t origin[3] = {o.x(), o.y(), o.z()};
+            std::memcpy(record, origin, sizeof(origin));
             const auto& mask = leaf->getValueMask();
-            for (size_t w = 0; w < kMaskWords; ++w) Put(mask.getWord<uint64_t>(w));
+            for (size_t w = 0; w < kMaskWords; ++w) {
+                const uint64_t word = mask.getWord<uint64_t>(w);
+                std::memcpy(record + sizeof(origin) + w * sizeof(word), &word, sizeof(word));
+            }
+            bytes_.append(record, kLeafBytes);
+            ++count;
         }
+        SetCount(count_at, count);
     }
     std::string Take() { return std::move(bytes_); }
 
@@ -62,6 +88,11 @@ public:
         pos_ += sizeof(T);
         return value;
     }
+    void GetBytes(void* into, size_t n) {
+        if (bytes_.size() - pos_ < n) Fail("truncated");
+        std::memcpy(into, bytes_.data() + pos_, n);
+        pos_ += n;
+    }
     // Three reads in order (the arguments of one constructor call are evaluated in any order).
     openvdb::Coord GetCoord() {
         const auto x = Get<int32_t>();
@@ -77,16 +108,15 @@ public:
     }
     openvdb::MaskTree::Ptr GetTree() {
         auto tree = std::make_shared<openvdb::MaskTree>();
-        const size_t n = Count(3 * sizeof(int32_t) + kMaskWords * sizeof(uint64_t));
+        openvdb::tree::ValueAccessor<openvdb::MaskTree> leaves(*tree);
+        const size_t n = Count(kLeafBytes);
         for (size_t i = 0; i < n; ++i) {
             const openvdb::Coord origin = GetCoord();
             if (LeafOrigin(origin) != origin) Fail("a leaf origin is not a multiple of 8");
-            if (tree->probeConstLeaf(origin)) Fail("a leaf appears twice");
-            auto* leaf = new MaskLeaf(origin, false);
-            for (size_t w = 0; w < kMaskWords; ++w) {
-                leaf->getValueMask().getWord<uint64_t>(w) = Get<uint64_t>();
-            }
-            tree->addLeaf(leaf);
+            if (leaves.probeConstLeaf(origin)) Fail("a leaf appears twice");
+            auto leaf = std::make_unique<MaskLeaf>(origin, false);
+            GetBytes(&leaf->getValueMask().getWord<uint64_t>(0), kMaskWords * sizeof(uint64_t));
+            leaves.addLeaf(leaf.release());
         }
         return tree;
     }
@@ -141,16 +171,30 @@ ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep) {
     return part;
 }
 
-std::string EncodeUpdate(const ScanUpdate& update) {
-    UpdateWriter w;
+std::string EncodeUpdate(const ScanUpdate& update, const LeafFilter& keep) {
+    const size_t leaves = update.free->leafCount() + update.occupied->leafCount();
+    UpdateWriter w(sizeof(kMagic) + 5 * sizeof(uint64_t) + leaves * kLeafBytes +
+                   update.endpoints.size() * kGroupBytes);
     w.Put(kMagic);
     w.Put(static_cast<uint64_t>(update.points));
     w.Put(static_cast<uint64_t>(update.dropped));
     w.Put(static_cast<uint64_t>(update.clipped));
-    w.PutTree(*update.free);
-    w.PutTree(*update.occupied);
-    w.Put(static_cast<uint64_t>(update.endpoints.size()));
+    w.PutTree(*update.free, keep);
+    w.PutTree(*update.occupied, keep);
+    const size_t count_at = w.PutCount();
+    uint64_t count = 0;
+    // Groups come sorted by voxel, so the voxels of one leaf mostly follow each other.
+    openvdb::Coord last(std::numeric_limits<int32_t>::max());
+    bool kept = true;
     for (const EndpointGroup& g : update.endpoints) {
+        if (keep) {
+            const openvdb::Coord origin = LeafOrigin(g.ijk);
+            if (origin != last) {
+                last = origin;
+                kept = keep(origin);
+            }
+        }
+        if (!kept) continue;
         w.Put(g.ijk.x());
         w.Put(g.ijk.y());
         w.Put(g.ijk.z());
@@ -159,7 +203,9 @@ std::string EncodeUpdate(const ScanUpdate& update) {
         w.Put(g.offset_sum.x());
         w.Put(g.offset_sum.y());
         w.Put(g.offset_sum.z());
+        ++count;
     }
+    w.SetCount(count_at, count);
     return w.Take();
 }
 
@@ -172,7 +218,7 @@ ScanUpdate DecodeUpdate(std::string_view bytes, const std::string& what) {
     update.clipped = static_cast<size_t>(r.Get<uint64_t>());
     update.free = r.GetTree();
     update.occupied = r.GetTree();
-    const size_t groups = r.Count(4 * sizeof(int32_t) + 1 + 3 * sizeof(double));
+    const size_t groups = r.Count(kGroupBytes);
     update.endpoints.resize(groups);
     for (EndpointGroup& g : update.endpoints) {
         g.ijk = r.GetCoord();

@@ -6,6 +6,8 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <string_view>
 
 #include "strata/core/Error.hpp"
 #include "strata/integration/UpdateParts.hpp"
@@ -69,13 +71,13 @@ void AppendPiece(std::string& message, const std::string& piece) {
     message += piece;
 }
 
-std::string NextPiece(const std::string& message, size_t& at, const std::string& what) {
+std::string_view NextPiece(const std::string& message, size_t& at, const std::string& what) {
     uint64_t n = 0;
     if (message.size() - at < sizeof(n)) throw FormatError(what + ": message cut short");
     std::copy_n(message.data() + at, sizeof(n), reinterpret_cast<char*>(&n));
     at += sizeof(n);
     if (message.size() - at < n) throw FormatError(what + ": message cut short");
-    std::string piece = message.substr(at, n);
+    const std::string_view piece(message.data() + at, n);
     at += n;
     return piece;
 }
@@ -247,11 +249,10 @@ RankedSessionResult IntegrateOnRanks(store::MapStore& map, size_t scans,
                     const integration::ScanUpdate update = writer->Compute(scan);
                     for (int d = 0; d < n; ++d) {
                         std::string& m = out[static_cast<size_t>(d)];
-                        AppendPiece(m, integration::EncodeUpdate(integration::SelectUpdate(
-                                           update, [&](const openvdb::Coord& leaf) {
-                                               return TileOwner(map.settings().TileOf(leaf), n) ==
-                                                      d;
-                                           })));
+                        AppendPiece(
+                            m, integration::EncodeUpdate(update, [&](const openvdb::Coord& leaf) {
+                                return TileOwner(map.settings().TileOf(leaf), n) == d;
+                            }));
                         if (d == 0) {
                             AppendPiece(
                                 m, RecordJson(store::SessionWriter::RecordOf(scan, update)).dump());

@@ -71,6 +71,20 @@ TEST(UpdateParts, EncodedUpdatesDecodeToTheSameUpdate) {
     }
 }
 
+// A part is encoded without building its trees: the bytes are those of the selected part's.
+TEST(UpdateParts, EncodingAPartGivesTheBytesOfTheSelectedPart) {
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    const ScanUpdate update = ComputeScanUpdate(LabelledRoom(7), map, {});
+    const LeafFilter odd = [](const openvdb::Coord& leaf) { return !EvenLeafColumn(leaf); };
+    for (const LeafFilter& keep : {LeafFilter(EvenLeafColumn), odd}) {
+        const std::string part = EncodeUpdate(update, keep);
+        EXPECT_EQ(part, EncodeUpdate(SelectUpdate(update, keep)));
+        EXPECT_LT(part.size(), EncodeUpdate(update).size());
+    }
+    EXPECT_EQ(EncodeUpdate(update, [](const openvdb::Coord&) { return true; }),
+              EncodeUpdate(update));
+}
+
 TEST(UpdateParts, DamagedBytesAreRefusedNamingTheSender) {
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     const std::string bytes = EncodeUpdate(ComputeScanUpdate(LabelledRoom(6, 500), map, {}));

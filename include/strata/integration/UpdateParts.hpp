@@ -25,8 +25,10 @@ using LeafFilter = std::function<bool(const openvdb::Coord& leaf_origin)>;
 /// then SelectUpdate would copy it whole.
 [[nodiscard]] bool AllLeaves(const ScanUpdate& update, const LeafFilter& keep);
 
-/// @brief The update as bytes (little-endian, versioned), to hand to another process.
-[[nodiscard]] std::string EncodeUpdate(const ScanUpdate& update);
+/// @brief The update as bytes (little-endian, versioned), to hand to another process; with
+/// `keep`, only its part in the leaves `keep` accepts (the bytes of EncodeUpdate(SelectUpdate(
+/// update, keep)), without building that part's trees).
+[[nodiscard]] std::string EncodeUpdate(const ScanUpdate& update, const LeafFilter& keep = {});
 
 /// @brief The update EncodeUpdate wrote.
 /// @throw FormatError when `bytes` is not an encoded update (truncated, trailing bytes, a bad
