@@ -11,11 +11,10 @@ if(STRATA_BUILD_FUZZ OR STRATA_SANITIZE)
                         "is ${CMAKE_CXX_COMPILER_ID}: configure a fresh build directory with "
                         "-DCMAKE_CXX_COMPILER=clang++ (tools/fuzz.sh and tools/sanitize.sh do)")
   endif()
-  # After the build type's -O2 -g, so these win: -O1 and line tables only, to compile the
-  # OpenVDB-heavy files faster; line tables are all a sanitizer report needs. With debug
-  # information ccache hashes the build directory; mapped to a path relative to the source
-  # root, it is the same in every clone (cmake/Ccache.cmake).
-  add_compile_options(-O1 -gline-tables-only -fdebug-prefix-map=${PROJECT_SOURCE_DIR}=.)
+  # After the build type's -O2 -g, so these win: line tables only, all a sanitizer report
+  # needs. With debug information ccache hashes the build directory; mapped to a path relative
+  # to the source root, it is the same in every clone (cmake/Ccache.cmake).
+  add_compile_options(-gline-tables-only -fdebug-prefix-map=${PROJECT_SOURCE_DIR}=.)
 endif()
 
 if(STRATA_BUILD_FUZZ AND STRATA_SANITIZE)
@@ -33,7 +32,11 @@ elseif(STRATA_BUILD_FUZZ)
   file(RELATIVE_PATH ignorelist_relative ${PROJECT_BINARY_DIR} ${ignorelist})
   file(MD5 ${ignorelist} ignorelist_md5)
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${ignorelist})
-  add_compile_options(-fsanitize=address,undefined
+  # Less UBSan's object-size check, which ASan's checks of every access cover: it kept clang
+  # from inlining Eigen, OpenVDB and the standard library (a 3x3 matrix times a vector left 72
+  # out-of-line Eigen functions with it, 22 without) and made the ASan tests ~30 % slower at
+  # -O2 (docs/reliability.md, "Sanitizers").
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize=object-size
                       -fno-sanitize-recover=undefined -fno-omit-frame-pointer
                       -fsanitize-ignorelist=${ignorelist_relative}
                       -Wno-unknown-warning-option)  # cmake/Warnings.cmake has gcc's -Wshadow=local
@@ -43,7 +46,8 @@ elseif(STRATA_SANITIZE STREQUAL "thread")
   # TBB's scheduler must be instrumented too, or every hand-over of work between its threads is
   # reported as a race: tools/sanitize.sh builds libtbb from Debian's source package with TSan
   # and puts it first on LD_LIBRARY_PATH for the tests (docs/reliability.md, "Sanitizers").
-  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer
+  # -O1: the TSan tests are short, and it compiles the OpenVDB-heavy files faster.
+  add_compile_options(-O1 -fsanitize=thread -fno-omit-frame-pointer
                       -Wno-unknown-warning-option)  # cmake/Warnings.cmake has gcc's -Wshadow=local
   add_link_options(-fsanitize=thread)
 elseif(STRATA_SANITIZE)
