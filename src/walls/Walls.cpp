@@ -9,6 +9,7 @@
 
 #include "Pieces.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/ParallelFor.hpp"
 #include "strata/geometry/Clustering.hpp"
 #include "strata/geometry/PlaneFit.hpp"
 
@@ -138,32 +139,43 @@ public:
                 members[cluster_of[n]].push_back(candidates[n]);
             }
         }
-        std::vector<std::pair<int, std::vector<openvdb::Coord>>> parts;
-        for (int c = 0; c < clusters; ++c) {
+        // Each cluster's K-means on its own seed, in parallel; the parts in cluster order.
+        std::vector<std::vector<std::vector<openvdb::Coord>>> local(members.size());
+        core::ParallelFor(members.size(), [&](size_t c) {
             const auto& voxels = members[c];
             const int k = PartsFor(voxels.size(), config_.kmeans_divisor);
-            const std::vector<int> part_of = KMeans(Positions(voxels), k, config_.seed + c);
-            std::vector<std::vector<openvdb::Coord>> local(static_cast<size_t>(k));
-            for (size_t n = 0; n < voxels.size(); ++n) local[part_of[n]].push_back(voxels[n]);
-            for (auto& p : local) {
-                if (!p.empty()) parts.emplace_back(c, std::move(p));
+            const std::vector<int> part_of =
+                KMeans(Positions(voxels), k, config_.seed + static_cast<uint64_t>(c));
+            local[c].resize(static_cast<size_t>(k));
+            for (size_t n = 0; n < voxels.size(); ++n) local[c][part_of[n]].push_back(voxels[n]);
+        });
+        std::vector<std::pair<int, std::vector<openvdb::Coord>>> parts;
+        for (size_t c = 0; c < local.size(); ++c) {
+            for (auto& p : local[c]) {
+                if (!p.empty()) parts.emplace_back(static_cast<int>(c), std::move(p));
             }
         }
         return parts;
     }
 
-    // RANSAC on one part, then the wall tests on its inliers; a part that passes becomes a
-    // piece of a wall.
-    void Judge(int cluster, const std::vector<openvdb::Coord>& voxels, uint64_t seed,
-               std::vector<Piece>& pieces) {
+    // What the wall tests made of one part, and the piece of a wall it became, if it passed.
+    struct Judged {
         WallPart part;
+        std::optional<Piece> piece;
+    };
+
+    // RANSAC on one part, then the wall tests on its inliers; a part that passes becomes a
+    // piece of a wall. Reads only: parts are judged in parallel.
+    [[nodiscard]] Judged Judge(int cluster, const std::vector<openvdb::Coord>& voxels,
+                               uint64_t seed) const {
+        Judged judged;
+        WallPart& part = judged.part;
         part.cluster = cluster;
         part.voxels = voxels.size();
         part.dominant_class = DominantClass(map_, voxels);
         if (voxels.size() < config_.min_part_voxels) {
             part.verdict = PartVerdict::kTooSmall;
-            result_.parts.push_back(part);
-            return;
+            return judged;
         }
         const std::vector<Eigen::Vector3d> points = Positions(voxels);
         const RansacResult ransac =
@@ -206,9 +218,9 @@ public:
             for (const auto& q : points) {
                 piece.inliers += std::abs(piece.plane.Distance(q)) <= threshold_;
             }
-            pieces.push_back(std::move(piece));
+            judged.piece = std::move(piece);
         }
-        result_.parts.push_back(part);
+        return judged;
     }
 
     // Groups of pieces that are one wall: close normals, close boxes, and one piece's plane
@@ -358,14 +370,26 @@ WallResult FindWallsAmong(const core::VoxelMap& map, const std::vector<openvdb::
     const auto parts = pipeline.Parts(candidates);
     result.stats.seconds_clustering = Seconds(t);
 
-    // 3. The wall tests per part, merging, one fit per wall.
+    // 3. The wall tests per part, merging, one fit per wall. Parts and walls are judged and
+    // fitted in parallel, each on its own seed, and taken in order: the result does not depend
+    // on the threads.
     t = Clock::now();
+    std::vector<Pipeline::Judged> judged(parts.size());
+    core::ParallelFor(parts.size(), [&](size_t p) {
+        judged[p] = pipeline.Judge(parts[p].first, parts[p].second, config.seed + p);
+    });
     std::vector<Piece> pieces;
-    for (size_t p = 0; p < parts.size(); ++p) {
-        pipeline.Judge(parts[p].first, parts[p].second, config.seed + p, pieces);
+    for (Pipeline::Judged& j : judged) {
+        result.parts.push_back(j.part);
+        if (j.piece) pieces.push_back(std::move(*j.piece));
     }
-    for (const auto& group : pipeline.Merge(pieces)) {
-        if (auto wall = pipeline.Fit(pieces, group)) result.walls.push_back(std::move(*wall));
+    judged.clear();
+    const std::vector<std::vector<size_t>> groups = pipeline.Merge(pieces);
+    std::vector<std::optional<Wall>> fitted(groups.size());
+    core::ParallelFor(groups.size(),
+                      [&](size_t g) { fitted[g] = pipeline.Fit(pieces, groups[g]); });
+    for (std::optional<Wall>& wall : fitted) {
+        if (wall) result.walls.push_back(std::move(*wall));
     }
     std::sort(result.walls.begin(), result.walls.end(),
               [](const Wall& a, const Wall& b) { return a.inliers > b.inliers; });

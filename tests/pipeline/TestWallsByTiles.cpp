@@ -1,6 +1,7 @@
 // Walls of a stored map read tile by tile are the walls of the map read whole (docs/walls.md,
 // "Tile by tile"): the simulated street in 6.4 m tiles, its facades crossing many tile borders.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 
@@ -90,6 +91,46 @@ TEST(WallsByTiles, ABudgetBelowOneTileAndItsHaloIsRefusedNamingTheFlag) {
         ADD_FAILURE() << "not refused";
     } catch (const RefusedError& e) {
         EXPECT_NE(std::string(e.what()).find("--memory-budget"), std::string::npos) << e.what();
+    }
+}
+
+// The stages after DBSCAN (K-means per cluster, the wall tests per part, one fit per wall) run
+// in parallel, each on its own seed, and are taken in order: one thread and four find the same
+// parts and walls, bit for bit.
+TEST(WallsOnThreads, OneThreadAndFourFindTheSameWalls) {
+    const store::MapStore map =
+        store::MapStore::Open(StreetInSmallTiles(), store::MapStore::Access::kRead);
+    const auto on = [&](int threads) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                        static_cast<size_t>(threads));
+        return FindWalls(map, map.Latest(), walls::WallConfig{}, 0).result;
+    };
+    const walls::WallResult one = on(1), four = on(4);
+    ASSERT_GE(one.walls.size(), 3u);
+    ASSERT_GT(one.stats.clusters, 3u) << "clusters to share among threads";
+    ASSERT_EQ(four.parts.size(), one.parts.size());
+    for (size_t i = 0; i < one.parts.size(); ++i) {
+        const walls::WallPart &a = four.parts[i], &b = one.parts[i];
+        SCOPED_TRACE("part " + std::to_string(i));
+        EXPECT_EQ(a.cluster, b.cluster);
+        EXPECT_EQ(a.voxels, b.voxels);
+        EXPECT_EQ(a.inliers, b.inliers);
+        EXPECT_EQ(a.slant_deg, b.slant_deg);
+        EXPECT_EQ(a.centroid, b.centroid);
+        EXPECT_EQ(a.verdict, b.verdict);
+    }
+    ASSERT_EQ(four.walls.size(), one.walls.size());
+    for (size_t i = 0; i < one.walls.size(); ++i) {
+        const walls::Wall &a = four.walls[i], &b = one.walls[i];
+        SCOPED_TRACE("wall " + std::to_string(b.id));
+        EXPECT_EQ(a.id, b.id);
+        EXPECT_EQ(a.slant_deg, b.slant_deg);
+        EXPECT_EQ(a.uncertainty_deg, b.uncertainty_deg);
+        EXPECT_EQ(a.normal, b.normal);
+        EXPECT_EQ(a.d, b.d);
+        EXPECT_EQ(a.inliers, b.inliers);
+        EXPECT_EQ(a.parts, b.parts);
+        EXPECT_EQ(a.voxels, b.voxels);
     }
 }
 
