@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/GridBox.hpp"
 
 namespace strata::columns {
 namespace {
@@ -98,18 +99,18 @@ ColumnGrid ColumnGrid::FromMap(const core::VoxelMap& map, const openvdb::CoordBB
     };
     auto hits = map.endpoints ? std::optional(core::EndpointReader(map)) : std::nullopt;
     auto label = map.label ? std::optional(map.label->getConstAccessor()) : std::nullopt;
-    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
-        if (*it <= 0.0f) continue;
-        openvdb::CoordBBox voxels;
-        it.getBoundingBox(voxels);  // one voxel, or every voxel of a tile
-        for (auto v = voxels.begin(); v; ++v) {
-            const openvdb::Coord& ijk = *v;
-            if (!inside(ijk)) continue;
-            const int64_t points = hits ? hits->Hits(ijk) : 1;
-            const int cls = label ? label->getValue(ijk) : -1;
-            AddVoxel(g.Mutable(ijk.x(), ijk.y()), ijk.z(), points, cls);
-        }
-    }
+    // One voxel, or every voxel of a tile.
+    core::ForEachActiveInColumns(
+        *map.occupancy, raster, [&](const openvdb::CoordBBox& voxels, float occupancy) {
+            if (occupancy <= 0.0f) return;
+            for (auto v = voxels.begin(); v; ++v) {
+                const openvdb::Coord& ijk = *v;
+                if (!inside(ijk)) continue;
+                const int64_t points = hits ? hits->Hits(ijk) : 1;
+                const int cls = label ? label->getValue(ijk) : -1;
+                AddVoxel(g.Mutable(ijk.x(), ijk.y()), ijk.z(), points, cls);
+            }
+        });
     return g;
 }
 

@@ -12,18 +12,10 @@
 
 namespace strata::geometry {
 
-std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
-                        int min_points) {
-    if (!(eps_voxels >= 1.0)) throw InvalidArgumentError("DBSCAN: eps must be >= 1 voxel");
-    if (min_points < 1) throw InvalidArgumentError("DBSCAN: min_points must be >= 1");
-    // The grid is the index: voxel -> position in `voxels` + 1 (0 = background).
-    auto index = openvdb::Int32Grid::create(0);
-    {
-        auto acc = index->getAccessor();
-        for (size_t n = 0; n < voxels.size(); ++n) {
-            acc.setValue(voxels[n], static_cast<int32_t>(n + 1));
-        }
-    }
+namespace {
+
+// The offsets of a voxel's neighbours within `eps_voxels` (itself included), z fastest.
+std::vector<openvdb::Coord> NeighbourOffsets(double eps_voxels) {
     const int r = static_cast<int>(std::floor(eps_voxels));
     std::vector<openvdb::Coord> offsets;
     for (int dz = -r; dz <= r; ++dz) {
@@ -35,6 +27,59 @@ std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_vo
             }
         }
     }
+    return offsets;
+}
+
+// The grid as the neighbour index: voxel -> position in `voxels` + 1 (0 = background).
+openvdb::Int32Grid::Ptr IndexOf(const std::vector<openvdb::Coord>& voxels) {
+    auto index = openvdb::Int32Grid::create(0);
+    auto acc = index->getAccessor();
+    for (size_t n = 0; n < voxels.size(); ++n) acc.setValue(voxels[n], static_cast<int32_t>(n + 1));
+    return index;
+}
+
+}  // namespace
+
+std::vector<std::vector<openvdb::Coord>> ConnectedVoxels(std::vector<openvdb::Coord> voxels,
+                                                         double eps_voxels) {
+    if (!(eps_voxels >= 1.0)) throw InvalidArgumentError("components: eps must be >= 1 voxel");
+    std::sort(voxels.begin(), voxels.end());
+    voxels.erase(std::unique(voxels.begin(), voxels.end()), voxels.end());
+    const openvdb::Int32Grid::Ptr index = IndexOf(voxels);
+    const auto acc = index->getConstAccessor();
+    const std::vector<openvdb::Coord> offsets = NeighbourOffsets(eps_voxels);
+    std::vector<bool> seen(voxels.size(), false);
+    std::vector<std::vector<openvdb::Coord>> components;
+    std::vector<int32_t> frontier;
+    for (size_t seed = 0; seed < voxels.size(); ++seed) {
+        if (seen[seed]) continue;
+        seen[seed] = true;
+        std::vector<openvdb::Coord> component;
+        frontier.assign(1, static_cast<int32_t>(seed));
+        while (!frontier.empty()) {
+            const openvdb::Coord c = voxels[frontier.back()];
+            frontier.pop_back();
+            component.push_back(c);
+            for (const openvdb::Coord& o : offsets) {
+                const int32_t n = acc.getValue(c + o) - 1;
+                if (n >= 0 && !seen[n]) {
+                    seen[n] = true;
+                    frontier.push_back(n);
+                }
+            }
+        }
+        std::sort(component.begin(), component.end());
+        components.push_back(std::move(component));
+    }
+    return components;
+}
+
+std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
+                        int min_points) {
+    if (!(eps_voxels >= 1.0)) throw InvalidArgumentError("DBSCAN: eps must be >= 1 voxel");
+    if (min_points < 1) throw InvalidArgumentError("DBSCAN: min_points must be >= 1");
+    const openvdb::Int32Grid::Ptr index = IndexOf(voxels);
+    const std::vector<openvdb::Coord> offsets = NeighbourOffsets(eps_voxels);
     auto acc = index->getConstAccessor();
     std::vector<int32_t> neighbours;
     auto neighbours_of = [&](const openvdb::Coord& c) {

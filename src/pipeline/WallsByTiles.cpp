@@ -7,11 +7,13 @@
 #include "WallsByTiles.hpp"
 
 #include <openvdb/tools/Morphology.h>
+#include <openvdb/tools/Prune.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -22,6 +24,7 @@
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/GridBox.hpp"
+#include "strata/geometry/Clustering.hpp"
 #include "strata/pipeline/RankedSession.hpp"
 #include "strata/store/TileReader.hpp"
 
@@ -174,25 +177,25 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
         CopyInsideAny(*tile->endpoints, boxes, *g.endpoints);
     }
 
-    // Column statistics over the group's tiles and halo, at the raster positions of the map's.
-    CoordBBox box;
-    for (const TileKey& k : group) box.expand(settings.TileBounds(k));
+    // Per tile, so that the column rasters stay a tile's size whatever the group's shape: column
+    // statistics over the tile and its halo (at the raster positions of the whole map's), the
+    // tile's columns counted, and its candidates with their endpoints and labels kept.
     const double s = g.voxel_size;
     const int radius = walls::WindowRadius(s, config);
-    const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(g, core::GrownXY(box, halo));
-    const columns::ColumnGrid window = cols.Window(radius);
-    const auto lowest_ends = g.endpoints->getConstAccessor();
+    openvdb::BoolGrid::Ptr mine = openvdb::BoolGrid::create(false);
     for (const TileKey& k : group) {
         const CoordBBox t = settings.TileBounds(k);
+        const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(g, core::GrownXY(t, halo));
+        const columns::ColumnGrid window = cols.Window(radius);
         for (int32_t j = t.min().y(); j <= t.max().y(); ++j) {
             for (int32_t i = t.min().x(); i <= t.max().x(); ++i) {
                 const columns::ColumnStat& c = cols.At(i, j);
                 if (c.voxels > 0) {
                     ++kept.occupied_columns;
                     kept.occupied.expand(Coord(i, j, 0));
-                    int32_t packed = 0;
-                    const bool has_mean = lowest_ends.probeValue(Coord(i, j, c.k_min), packed);
-                    kept.lowest.push_back({j, i, c.k_min, packed, has_mean ? 1 : 0});
+                    if (kept.ground.Admits(i, j)) {
+                        kept.ground.Add(i, j, g.PointMean(Coord(i, j, c.k_min)));
+                    }
                 }
                 if (walls::WindowVotes(window.At(i, j), s, radius, config)) {
                     if (c.voxels > 0) {
@@ -203,21 +206,15 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
                 }
             }
         }
-    }
-
-    // The group's own candidates, their endpoints and labels, and the occupancy around them.
-    openvdb::BoolGrid::Ptr mine = openvdb::BoolGrid::create(false);
-    {
         auto mine_acc = mine->getAccessor();
-        auto all = kept.candidates->getAccessor();
         const auto ends = g.endpoints->getConstAccessor();
         const auto labels = g.label->getConstAccessor();
         auto kept_ends = kept.map.endpoints->getAccessor();
         auto kept_labels = kept.map.label->getAccessor();
         for (const Coord& c : walls::VoteCandidates(g, window, radius, config)) {
-            if (!in.count(settings.TileOf(c))) continue;
+            if (settings.TileOf(c) != k) continue;
             mine_acc.setValueOn(c, true);
-            all.setValueOn(c, true);
+            kept.candidates.push_back(c);
             CopyValue(ends, kept_ends, c);
             CopyValue(labels, kept_labels, c);
         }
@@ -234,6 +231,75 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
             if (occupancy.probeValue(*v, value) && value <= 0.0f) kept_free.setValueOn(*v, true);
         }
     }
+}
+
+// The memory of what is kept across groups.
+size_t KeptBytes(const WallsKept& kept) {
+    size_t bytes = kept.observed_free->memUsage() + kept.candidates.capacity() * sizeof(Coord) +
+                   kept.ground.entries().capacity() * sizeof(walls::GroundSample::Entry) +
+                   kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
+    for (const auto& grid : kept.map.Grids()) bytes += grid->memUsage();
+    return bytes;
+}
+
+// Drops the leaves of `grid` that overlap none of `live`.
+template <typename GridT>
+void KeepOnly(GridT& grid, const std::vector<CoordBBox>& live) {
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    std::vector<Coord> drop;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+        const CoordBBox bounds = leaf->getNodeBoundingBox();
+        if (std::none_of(live.begin(), live.end(),
+                         [&](const CoordBBox& b) { return b.hasOverlap(bounds); })) {
+            drop.push_back(leaf->origin());
+        }
+    }
+    for (const Coord& origin : drop) {
+        delete grid.tree().template stealNode<LeafT>(origin, grid.background(), false);
+    }
+    openvdb::tools::pruneInactive(grid.tree());
+}
+
+// After the groups up to the tile `last` (in key order) were read: hands the candidates whose
+// every neighbour within DBSCAN's reach has been read to the later stages, fits the walls no
+// candidate still to come can join, and drops the voxels nothing waiting needs any more.
+void HandOn(const store::MapSettings& settings, const TileKey& last,
+            const walls::WallConfig& config, WallsKept& kept, walls::WallAssembler& assembler) {
+    // Groups are consecutive tiles in key order (x, then y): a box's tiles have all been read
+    // when its last one, (largest x, largest y), has.
+    const auto read = [&](const CoordBBox& box) {
+        const TileKey hi = settings.TileOf(box.max());
+        return !(last < hi);
+    };
+    const int reach = static_cast<int>(std::floor(config.dbscan_eps_voxels));
+    std::vector<std::vector<Coord>> done;
+    std::vector<CoordBBox> waiting;  // boxes of the candidates still waiting
+    std::vector<Coord> left;
+    for (std::vector<Coord>& group :
+         geometry::ConnectedVoxels(std::move(kept.candidates), config.dbscan_eps_voxels)) {
+        CoordBBox box;
+        for (const Coord& c : group) box.expand(c);
+        if (read(core::GrownXY(box, reach))) {
+            done.push_back(std::move(group));
+        } else {
+            waiting.push_back(box);
+            left.insert(left.end(), group.begin(), group.end());
+        }
+    }
+    kept.candidates = std::move(left);
+    assembler.Add(done);
+    assembler.FitSettled([&](const CoordBBox& box) {
+        return !read(box) || std::any_of(waiting.begin(), waiting.end(),
+                                         [&](const CoordBBox& w) { return w.hasOverlap(box); });
+    });
+    // What the waiting candidates and pieces read: their endpoints and labels, and what was
+    // seen free near them.
+    std::vector<CoordBBox> live = assembler.PendingBoxes();
+    live.insert(live.end(), waiting.begin(), waiting.end());
+    for (CoordBBox& box : live) box.expand(walls::kObservedSideReachVoxels + 1);
+    KeepOnly(*kept.map.endpoints, live);
+    KeepOnly(*kept.map.label, live);
+    KeepOnly(*kept.observed_free, live);
 }
 
 // The budget groups are split by: on several ranks at most an even share of the map (so that
@@ -269,12 +335,25 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     const store::TileReader reader(map, snapshot, 0);
     WallsKept kept;
     kept.map = map.EmptyMap();
-    size_t mine = 0;
+    // One process hands each group's finished candidates on as it goes (slants against the
+    // map's z axis need nothing of the later groups); on several ranks, or levelled to a ground
+    // still unknown, rank 0 takes them all at the end.
+    const bool streamed = ranks.size() == 1 && !config.level_to_ground;
+    std::optional<walls::WallAssembler> assembler;
+    if (streamed)
+        assembler.emplace(kept.map, config, Eigen::Vector3d::UnitZ(), kept.observed_free.get());
+    size_t mine = 0, kept_bytes = 0;
+    std::chrono::steady_clock::duration handing_on{};  // the later stages' share of the loop
     OnEveryRank(ranks, [&] {
         for (size_t g = static_cast<size_t>(ranks.rank()); g < split.size();
              g += static_cast<size_t>(ranks.size())) {
             CollectGroup(reader, settings, split[g], groups, halo, config, kept);
             ++mine;
+            kept_bytes = std::max(kept_bytes, KeptBytes(kept));
+            if (!streamed) continue;
+            const auto t = std::chrono::steady_clock::now();
+            HandOn(settings, split[g].back(), config, kept, *assembler);
+            handing_on += std::chrono::steady_clock::now() - t;
         }
     });
     if (ranks.size() > 1) {
@@ -286,6 +365,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
             return outcome;
         }
         for (size_t r = 1; r < all.size(); ++r) MergeKept(all[r], kept);
+        kept_bytes = std::max(kept_bytes, KeptBytes(kept));
     }
 
     walls::WallResult voted;
@@ -295,37 +375,22 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     for (const auto& [i, j] : kept.voting_empty) {
         voted.stats.voting_columns += kept.occupied.isInside(Coord(i, j, 0));
     }
-    size_t kept_bytes = kept.candidates->memUsage() + kept.observed_free->memUsage() +
-                        kept.lowest.capacity() * sizeof(WallsKept::Lowest) +
-                        kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
-    for (const auto& grid : kept.map.Grids()) kept_bytes += grid->memUsage();
-    std::sort(kept.lowest.begin(), kept.lowest.end(),
-              [](const auto& a, const auto& b) { return a.j != b.j ? a.j < b.j : a.i < b.i; });
-    // The means of the sample only, as VoxelMap::PointMean computes them.
-    std::vector<Eigen::Vector3d> lowest;
-    for (size_t n : walls::GroundSample(kept.lowest.size())) {
-        const WallsKept::Lowest& l = kept.lowest[n];
-        const Eigen::Vector3d centre = kept.map.VoxelCenter(Coord(l.i, l.j, l.k));
-        lowest.push_back(l.has_mean ? centre + core::endpoint::Offset(l.packed, kept.map.voxel_size)
-                                    : centre);
-    }
-    kept.lowest = {};
-    voted.ground = walls::FitGround(std::move(lowest), settings.voxel_size_m, config.seed);
-    // The occupancy tree's order, as VoteCandidates gives a whole map's candidates.
-    std::vector<Coord> candidates;
-    for (auto it = kept.candidates->cbeginValueOn(); it; ++it) {
-        const CoordBBox voxels = it.getBoundingBox();
-        for (auto v = voxels.begin(); v; ++v) candidates.push_back(*v);
-    }
+    voted.ground = walls::FitGround(kept.ground, settings.voxel_size_m, config.seed);
     voted.stats.seconds_columns =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start - handing_on)
+            .count();
+    if (!assembler) {
+        assembler.emplace(kept.map, config, walls::UpOf(config, voted.ground),
+                          kept.observed_free.get());
+    }
+    assembler->Add(geometry::ConnectedVoxels(std::move(kept.candidates), config.dbscan_eps_voxels));
 
     WallsOutcome outcome;
     outcome.commit = snapshot.commit;
     outcome.tile_groups = split.size();
     outcome.kept_bytes = kept_bytes;
-    outcome.result = walls::FindWallsAmong(kept.map, candidates, std::move(voted), config,
-                                           kept.observed_free.get());
+    outcome.result = assembler->Finish(std::move(voted));
+    assembler.reset();
     outcome.map = std::move(kept.map);
     return outcome;
 }

@@ -17,7 +17,6 @@ namespace {
 using openvdb::Coord;
 using openvdb::CoordBBox;
 
-constexpr const char* kCandidatesGrid = "wall_candidates";
 constexpr const char* kObservedFreeGrid = "observed_free";
 
 // Copies every voxel `from` holds (active, or inactive with a value of its own) into `into`.
@@ -47,12 +46,11 @@ std::string EncodeKept(const WallsKept& k) {
     Put(out, k.voting_columns);
     Put(out, k.occupied.min());
     Put(out, k.occupied.max());
-    PutVector(out, k.lowest);
+    PutVector(out, k.ground.entries());
     PutVector(out, k.voting_empty);
+    PutVector(out, k.candidates);
     openvdb::GridPtrVec grids = k.map.Grids();
-    k.candidates->setName(kCandidatesGrid);
     k.observed_free->setName(kObservedFreeGrid);
-    grids.push_back(k.candidates);
     grids.push_back(k.observed_free);
     std::ostringstream os(std::ios_base::binary);
     openvdb::io::Stream(os).write(grids);
@@ -68,25 +66,23 @@ void MergeKept(const std::string& bytes, WallsKept& into) {
         into.occupied.expand(lo);
         into.occupied.expand(hi);
     }
-    for (const WallsKept::Lowest& l : in.GetVector<WallsKept::Lowest>()) into.lowest.push_back(l);
+    for (const auto& e : in.GetVector<walls::GroundSample::Entry>()) into.ground.Add(e);
     for (const auto& e : in.GetVector<std::pair<int32_t, int32_t>>()) {
         into.voting_empty.push_back(e);
     }
+    for (const Coord& c : in.GetVector<Coord>()) into.candidates.push_back(c);
     std::istringstream is(in.Rest(), std::ios_base::binary);
     openvdb::io::Stream stream(is, /*delayLoad=*/false);
     openvdb::GridPtrVec grids = *stream.getGrids();
-    for (const auto& [wanted, to] : {std::pair{kCandidatesGrid, into.candidates},
-                                     std::pair{kObservedFreeGrid, into.observed_free}}) {
-        // A structured binding cannot be captured before C++20 (clang refuses it).
-        const std::string name = wanted;
-        const auto it = std::find_if(grids.begin(), grids.end(),
-                                     [&](const auto& g) { return g->getName() == name; });
-        const auto grid =
-            it == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::BoolGrid>(*it);
-        if (!grid) throw FormatError(std::string("walls: a rank's answer has no ") + name);
-        MergeVoxels(*grid, *to);
-        grids.erase(it);
+    const auto it = std::find_if(grids.begin(), grids.end(),
+                                 [](const auto& g) { return g->getName() == kObservedFreeGrid; });
+    const auto observed_free =
+        it == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::BoolGrid>(*it);
+    if (!observed_free) {
+        throw FormatError(std::string("walls: a rank's answer has no ") + kObservedFreeGrid);
     }
+    MergeVoxels(*observed_free, *into.observed_free);
+    grids.erase(it);
     const core::VoxelMap map = core::VoxelMap::FromGrids(grids);
     MergeVoxels(*map.label, *into.map.label);
     MergeVoxels(*map.endpoints, *into.map.endpoints);

@@ -10,23 +10,19 @@
 
 #include "strata/core/GridTypes.hpp"
 #include "strata/core/VoxelMap.hpp"
+#include "strata/walls/Walls.hpp"
 
 namespace strata::pipeline::detail {
 
 /// @brief What the groups leave for the stages after voting, and stage 1's counts.
 struct WallsKept {
     core::VoxelMap map;  ///< the candidates' endpoints and labels (no occupancy)
-    openvdb::BoolGrid::Ptr candidates = openvdb::BoolGrid::create(false);
+    /// The candidates not yet handed to the stages after voting.
+    std::vector<openvdb::Coord> candidates;
     /// The voxels seen free within walls::kObservedSideReachVoxels of a candidate: all the later
     /// stages read of the occupancy, in a BoolGrid's memory.
     openvdb::BoolGrid::Ptr observed_free = openvdb::BoolGrid::create(false);
-    /// The lowest voxel of an occupied column and its packed endpoints (has_mean 0: none), the
-    /// mean computed for GroundSample's columns only: 20 bytes per column.
-    struct Lowest {
-        int32_t j, i, k;
-        int32_t packed, has_mean;
-    };
-    std::vector<Lowest> lowest;
+    walls::GroundSample ground;  ///< the lowest voxels the ground plane is fitted to
     std::vector<std::pair<int32_t, int32_t>> voting_empty;  // voting columns with no voxel
     openvdb::CoordBBox occupied;                            // columns with an occupied voxel
     size_t occupied_columns = 0, voting_columns = 0;

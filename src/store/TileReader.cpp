@@ -117,13 +117,18 @@ std::vector<TileKey> TileReader::SessionTiles(int64_t session) const {
     return out;
 }
 
-std::shared_ptr<const core::VoxelMap> TileReader::Fused(const TileKey& key) const {
+const TileVersion* TileReader::Version(const TileKey& key) const {
     const auto it =
         std::lower_bound(snapshot_.tiles.begin(), snapshot_.tiles.end(), key,
                          [](const TileVersion& v, const TileKey& k) { return v.key < k; });
-    if (it == snapshot_.tiles.end() || it->key != key) return nullptr;
-    return cache_->Get<core::VoxelMap>(it->file, [&] {
-        auto map = std::make_shared<const core::VoxelMap>(store_->ReadFused(*it));
+    return it == snapshot_.tiles.end() || it->key != key ? nullptr : &*it;
+}
+
+std::shared_ptr<const core::VoxelMap> TileReader::Fused(const TileKey& key) const {
+    const TileVersion* version = Version(key);
+    if (!version) return nullptr;
+    return cache_->Get<core::VoxelMap>(version->file, [&] {
+        auto map = std::make_shared<const core::VoxelMap>(store_->ReadFused(*version));
         return std::make_pair(std::shared_ptr<const core::VoxelMap>(map), Bytes(map->Grids()));
     });
 }
@@ -152,14 +157,21 @@ openvdb::GridPtrVec TileReader::Products(const TileKey& key, const std::string& 
 }
 
 core::VoxelMap TileReader::LoadFused(const std::vector<TileKey>& keys) const {
-    std::vector<core::VoxelMap> tiles(keys.size());
-    core::ParallelFor(keys.size(), [&](size_t i) {
-        if (const auto tile = Fused(keys[i])) tiles[i] = tile->DeepCopy();
-    });
     core::VoxelMap map = store_->EmptyMap();
-    for (core::VoxelMap& tile : tiles) {
-        if (tile.occupancy) detail::MergeMap(map, tile);
-    }
+    std::mutex merging;
+    // Each tile joins the map as soon as it is read, so beside the map at most one tile per
+    // thread is held; without a cache the file is decoded straight into the copy.
+    core::ParallelFor(keys.size(), [&](size_t i) {
+        core::VoxelMap tile;
+        if (cache_->budget_bytes > 0) {
+            if (const auto shared = Fused(keys[i])) tile = shared->DeepCopy();
+        } else if (const TileVersion* version = Version(keys[i])) {
+            tile = store_->ReadFused(*version);
+        }
+        if (!tile.occupancy) return;
+        const std::lock_guard<std::mutex> lock(merging);
+        detail::MergeMap(map, tile);
+    });
     return map;
 }
 

@@ -12,9 +12,18 @@
 
 namespace strata::walls::detail {
 
+// A K-means part: its cluster's first voxel and its number in the cluster, which name it
+// whatever else the map holds.
+struct PartKey {
+    openvdb::Coord cluster;
+    int part = 0;
+    friend bool operator<(const PartKey& a, const PartKey& b) {
+        return a.cluster != b.cluster ? a.cluster < b.cluster : a.part < b.part;
+    }
+};
+
 // An accepted part, before merging.
 struct Piece {
-    int cluster = 0;
     geometry::Plane plane;
     Eigen::Vector3d centroid;
     Eigen::Vector3d lo, hi;               // box of the inliers

@@ -2,9 +2,11 @@
 // the ground plane the slants may be measured against.
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <utility>
 #include <vector>
 
+#include "strata/core/GridBox.hpp"
 #include "strata/geometry/PlaneFit.hpp"
 #include "strata/walls/Walls.hpp"
 
@@ -47,55 +49,87 @@ std::vector<openvdb::Coord> VoteCandidates(const core::VoxelMap& map,
         }
     }
     std::vector<openvdb::Coord> candidates;
-    for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
-        if (*it <= 0.0f) continue;
-        openvdb::CoordBBox box;
-        it.getBoundingBox(box);
-        for (auto v = box.begin(); v; ++v) {
-            const openvdb::Coord& ijk = *v;
-            const columns::ColumnStat& w = window.At(ijk.x(), ijk.y());
-            if (votes(w) && ijk.z() >= w.k_min + clearance) candidates.push_back(ijk);
-        }
-    }
+    if (window.empty()) return candidates;
+    const openvdb::CoordBBox raster(openvdb::Coord(window.min_i(), window.min_j(), 0),
+                                    openvdb::Coord(window.min_i() + window.width() - 1,
+                                                   window.min_j() + window.height() - 1, 0));
+    core::ForEachActiveInColumns(*map.occupancy, raster,
+                                 [&](const openvdb::CoordBBox& voxels, float occupancy) {
+                                     if (occupancy <= 0.0f) return;
+                                     for (auto v = voxels.begin(); v; ++v) {
+                                         const openvdb::Coord& ijk = *v;
+                                         const columns::ColumnStat& w = window.At(ijk.x(), ijk.y());
+                                         if (votes(w) && ijk.z() >= w.k_min + clearance)
+                                             candidates.push_back(ijk);
+                                     }
+                                 });
     return candidates;
 }
 
 GroundPlane EstimateGround(const core::VoxelMap& map, const columns::ColumnGrid& columns,
                            uint64_t seed) {
-    std::vector<Eigen::Vector3d> lowest;
+    GroundSample sample;
     for (int j = 0; j < columns.height(); ++j) {
         for (int i = 0; i < columns.width(); ++i) {
             const openvdb::Coord column(columns.min_i() + i, columns.min_j() + j, 0);
             const columns::ColumnStat& c = columns.At(column.x(), column.y());
-            if (c.voxels > 0) lowest.push_back(map.PointMean(column.offsetBy(0, 0, c.k_min)));
+            if (c.voxels > 0 && sample.Admits(column.x(), column.y())) {
+                sample.Add(column.x(), column.y(), map.PointMean(column.offsetBy(0, 0, c.k_min)));
+            }
         }
     }
-    return FitGround(std::move(lowest), map.voxel_size, seed);
+    return FitGround(sample, map.voxel_size, seed);
 }
 
-std::vector<size_t> GroundSample(size_t columns) {
-    constexpr size_t kMaxColumns = 50000;  // a sample is plenty for one plane
-    std::vector<size_t> sample;
-    const size_t n = std::min(columns, kMaxColumns);
-    const double step = static_cast<double>(columns) / static_cast<double>(n);
-    sample.reserve(n);
-    for (size_t k = 0; k < n; ++k) {
-        sample.push_back(columns > kMaxColumns ? static_cast<size_t>(static_cast<double>(k) * step)
-                                               : k);
+namespace {
+
+uint64_t ColumnHash(int32_t i, int32_t j) {
+    uint64_t z = (uint64_t{static_cast<uint32_t>(i)} << 32) | static_cast<uint32_t>(j);
+    z += 0x9E3779B97F4A7C15ull;  // splitmix64
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+bool Before(const GroundSample::Entry& a, const GroundSample::Entry& b) {
+    return std::tie(a.hash, a.j, a.i) < std::tie(b.hash, b.j, b.i);
+}
+
+}  // namespace
+
+bool GroundSample::Admits(int32_t i, int32_t j) const {
+    return heap_.size() < kMaxColumns || Before(Entry{ColumnHash(i, j), j, i, 0, 0, 0}, heap_[0]);
+}
+
+void GroundSample::Add(int32_t i, int32_t j, const Eigen::Vector3d& lowest) {
+    Add(Entry{ColumnHash(i, j), j, i, lowest.x(), lowest.y(), lowest.z()});
+}
+
+void GroundSample::Add(const Entry& e) {
+    if (heap_.size() == kMaxColumns) {
+        if (!Before(e, heap_[0])) return;
+        std::pop_heap(heap_.begin(), heap_.end(), Before);
+        heap_.pop_back();
     }
-    return sample;
+    heap_.push_back(e);
+    std::push_heap(heap_.begin(), heap_.end(), Before);
 }
 
-GroundPlane FitGround(std::vector<Eigen::Vector3d> lowest, double voxel_size, uint64_t seed) {
+std::vector<Eigen::Vector3d> GroundSample::InRasterOrder() const {
+    std::vector<Entry> sorted = heap_;
+    std::sort(sorted.begin(), sorted.end(), [](const Entry& a, const Entry& b) {
+        return std::tie(a.j, a.i) < std::tie(b.j, b.i);
+    });
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(sorted.size());
+    for (const Entry& e : sorted) points.emplace_back(e.x, e.y, e.z);
+    return points;
+}
+
+GroundPlane FitGround(const GroundSample& sample, double voxel_size, uint64_t seed) {
     GroundPlane ground;
+    const std::vector<Eigen::Vector3d> lowest = sample.InRasterOrder();
     if (lowest.size() < 3) return ground;
-    const std::vector<size_t> sample = GroundSample(lowest.size());
-    if (sample.size() < lowest.size()) {
-        std::vector<Eigen::Vector3d> points;
-        points.reserve(sample.size());
-        for (size_t k : sample) points.push_back(lowest[k]);
-        lowest.swap(points);
-    }
     const RansacResult r = RansacPlane(lowest, voxel_size, 200, seed);
     ground.normal = r.plane.normal.z() < 0.0 ? Eigen::Vector3d(-r.plane.normal) : r.plane.normal;
     ground.tilt_deg = SlantDeg(ground.normal);  // 0 for a level ground

@@ -46,6 +46,7 @@ void Require(bool ok, const char* what) {
 using detail::BoxGap;
 using detail::DominantClass;
 using detail::HorizontalExtent;
+using detail::PartKey;
 using detail::Piece;
 using detail::SpreadOfMean;
 using detail::Support;
@@ -100,15 +101,29 @@ void WallConfig::Validate() const {
 
 namespace {
 
-// The stages after voting, sharing the map, the settings and the result being filled.
-class Pipeline {
-public:
-    Pipeline(const core::VoxelMap& map, const openvdb::BoolGrid* observed_free,
-             const WallConfig& config, WallResult& result)
+// A seed drawn from a voxel and a number (splitmix64 of each in turn): the same wherever the
+// voxel's group of candidates was read.
+uint64_t SeedOf(uint64_t seed, const openvdb::Coord& c, uint64_t n) {
+    auto mix = [](uint64_t z) {
+        z += 0x9E3779B97F4A7C15ull;
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    };
+    uint64_t h = mix(seed);
+    for (const int32_t v : {c.x(), c.y(), c.z()}) h = mix(h ^ static_cast<uint32_t>(v));
+    return mix(h ^ n);
+}
+
+}  // namespace
+
+struct WallAssembler::Impl {
+    Impl(const core::VoxelMap& map, const WallConfig& config, const Eigen::Vector3d& up,
+         const openvdb::BoolGrid* observed_free)
         : map_(map),
           observed_free_(observed_free),
           config_(config),
-          result_(result),
+          up_(up),
           s_(map.voxel_size),
           threshold_(config.ransac_threshold_m > 0.0 ? config.ransac_threshold_m : 0.5 * s_) {}
 
@@ -123,36 +138,46 @@ public:
         return points;
     }
 
-    // DBSCAN over the candidates, then K-means inside each cluster: the parts.
-    [[nodiscard]] std::vector<std::pair<int, std::vector<openvdb::Coord>>> Parts(
-        const std::vector<openvdb::Coord>& candidates) {
-        const std::vector<int> cluster_of =
-            Dbscan(candidates, config_.dbscan_eps_voxels, config_.dbscan_min_points);
-        int clusters = 0;
-        for (int c : cluster_of) clusters = std::max(clusters, c + 1);
-        result_.stats.clusters = static_cast<size_t>(clusters);
-        std::vector<std::vector<openvdb::Coord>> members(static_cast<size_t>(clusters));
-        for (size_t n = 0; n < candidates.size(); ++n) {
-            if (cluster_of[n] == kNoise) {
-                ++result_.stats.noise_voxels;
-            } else {
-                members[cluster_of[n]].push_back(candidates[n]);
+    // DBSCAN of each group, then K-means inside each cluster: the parts, named by their key.
+    [[nodiscard]] std::vector<std::pair<PartKey, std::vector<openvdb::Coord>>> Parts(
+        const std::vector<std::vector<openvdb::Coord>>& groups) {
+        std::vector<std::vector<int>> cluster_of(groups.size());
+        core::ParallelFor(groups.size(), [&](size_t g) {
+            cluster_of[g] = Dbscan(groups[g], config_.dbscan_eps_voxels, config_.dbscan_min_points);
+        });
+        // Each cluster's voxels in Coord's order (a group's own); its key is the first.
+        std::vector<std::vector<openvdb::Coord>> members;
+        for (size_t g = 0; g < groups.size(); ++g) {
+            const size_t first = members.size();
+            for (size_t n = 0; n < groups[g].size(); ++n) {
+                const int c = cluster_of[g][n];
+                if (c == kNoise) {
+                    ++stats_.noise_voxels;
+                    continue;
+                }
+                if (first + static_cast<size_t>(c) >= members.size()) {
+                    members.resize(first + static_cast<size_t>(c) + 1);
+                }
+                members[first + static_cast<size_t>(c)].push_back(groups[g][n]);
             }
         }
-        // Each cluster's K-means on its own seed, in parallel; the parts in cluster order.
+        stats_.clusters += members.size();
+        // Each cluster's K-means on a seed of its own, in parallel; parts in cluster order.
         std::vector<std::vector<std::vector<openvdb::Coord>>> local(members.size());
         core::ParallelFor(members.size(), [&](size_t c) {
             const auto& voxels = members[c];
             const int k = PartsFor(voxels.size(), config_.kmeans_divisor);
             const std::vector<int> part_of =
-                KMeans(Positions(voxels), k, config_.seed + static_cast<uint64_t>(c));
+                KMeans(Positions(voxels), k, SeedOf(config_.seed, voxels.front(), 0));
             local[c].resize(static_cast<size_t>(k));
             for (size_t n = 0; n < voxels.size(); ++n) local[c][part_of[n]].push_back(voxels[n]);
         });
-        std::vector<std::pair<int, std::vector<openvdb::Coord>>> parts;
+        std::vector<std::pair<PartKey, std::vector<openvdb::Coord>>> parts;
         for (size_t c = 0; c < local.size(); ++c) {
-            for (auto& p : local[c]) {
-                if (!p.empty()) parts.emplace_back(static_cast<int>(c), std::move(p));
+            for (size_t p = 0; p < local[c].size(); ++p) {
+                if (local[c][p].empty()) continue;
+                parts.emplace_back(PartKey{members[c].front(), static_cast<int>(p)},
+                                   std::move(local[c][p]));
             }
         }
         return parts;
@@ -166,11 +191,10 @@ public:
 
     // RANSAC on one part, then the wall tests on its inliers; a part that passes becomes a
     // piece of a wall. Reads only: parts are judged in parallel.
-    [[nodiscard]] Judged Judge(int cluster, const std::vector<openvdb::Coord>& voxels,
-                               uint64_t seed) const {
+    [[nodiscard]] Judged Judge(const PartKey& key,
+                               const std::vector<openvdb::Coord>& voxels) const {
         Judged judged;
         WallPart& part = judged.part;
-        part.cluster = cluster;
         part.voxels = voxels.size();
         part.dominant_class = DominantClass(map_, voxels);
         if (voxels.size() < config_.min_part_voxels) {
@@ -179,7 +203,8 @@ public:
         }
         const std::vector<Eigen::Vector3d> points = Positions(voxels);
         const RansacResult ransac =
-            RansacPlane(points, threshold_, config_.ransac_iterations, seed);
+            RansacPlane(points, threshold_, config_.ransac_iterations,
+                        SeedOf(config_.seed, key.cluster, 1 + static_cast<uint64_t>(key.part)));
         std::vector<Eigen::Vector3d> inliers;
         inliers.reserve(ransac.inliers);
         Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -191,7 +216,7 @@ public:
         }
         part.inliers = inliers.size();
         part.eigen_ratio = XyEigenRatio(inliers);
-        part.slant_deg = SlantDeg(ransac.plane.normal, result_.up);
+        part.slant_deg = SlantDeg(ransac.plane.normal, up_);
         part.height_m = inliers.empty() ? 0.0 : hi.z() - lo.z() + s_;
         part.length_m = HorizontalExtent(inliers, ransac.plane.normal) + s_;
         for (const auto& q : inliers) part.centroid += q;
@@ -211,7 +236,7 @@ public:
             part.verdict = PartVerdict::kWall;
             // Merging compares planes, so each piece gets the robust fit too: a RANSAC plane of
             // a facade with deep windows can be off by degrees.
-            Piece piece{part.cluster, ransac.plane, part.centroid, lo, hi, voxels, points, 0};
+            Piece piece{ransac.plane, part.centroid, lo, hi, voxels, points, 0};
             if (config_.refine) {
                 piece.plane = RefinePlane(inliers, ransac.plane, 0.25 * threshold_);
             }
@@ -223,48 +248,41 @@ public:
         return judged;
     }
 
-    // Groups of pieces that are one wall: close normals, close boxes, and one piece's plane
+    // Whether two pieces are one wall: close normals, close boxes, and one piece's plane
     // holding the other's voxels nearly as well as its own.
-    [[nodiscard]] std::vector<std::vector<size_t>> Merge(const std::vector<Piece>& pieces) const {
-        UnionFind groups(pieces.size());
+    [[nodiscard]] bool OneWall(const Piece& a, const Piece& b) const {
         const double cos_merge = std::cos(config_.merge_angle_deg * M_PI / 180.0);
-        for (size_t a = 0; a < pieces.size(); ++a) {
-            for (size_t b = a + 1; b < pieces.size(); ++b) {
-                const Piece& pa = pieces[a];
-                const Piece& pb = pieces[b];
-                if (std::abs(pa.plane.normal.dot(pb.plane.normal)) < cos_merge) continue;
-                if (BoxGap(pa, pb) > config_.merge_gap_m) continue;
-                if (std::max(Support(pa, pb, threshold_), Support(pb, pa, threshold_)) <
-                    config_.merge_support) {
-                    continue;
-                }
-                groups.Join(static_cast<int>(a), static_cast<int>(b));
-            }
-        }
-        std::vector<std::vector<size_t>> members(pieces.size());
-        for (size_t a = 0; a < pieces.size(); ++a) {
-            members[groups.Find(static_cast<int>(a))].push_back(a);
-        }
-        members.erase(
-            std::remove_if(members.begin(), members.end(), [](const auto& g) { return g.empty(); }),
-            members.end());
-        return members;
+        return std::abs(a.plane.normal.dot(b.plane.normal)) >= cos_merge &&
+               BoxGap(a, b) <= config_.merge_gap_m &&
+               std::max(Support(a, b, threshold_), Support(b, a, threshold_)) >=
+                   config_.merge_support;
+    }
+
+    // The voxels a piece comes near enough to for a later piece there to merge with it: its
+    // box grown by the merge gap and a voxel (a piece's means lie inside its voxels).
+    [[nodiscard]] openvdb::CoordBBox Reach(const Piece& p) const {
+        const Eigen::Vector3d gap = Eigen::Vector3d::Constant(config_.merge_gap_m);
+        openvdb::CoordBBox box(map_.WorldToVoxel(p.lo - gap), map_.WorldToVoxel(p.hi + gap));
+        box.expand(1);
+        return box;
     }
 
     // One plane for a whole wall: RANSAC on all its pieces' voxels (a piece's own plane may be
     // off), then the robust fit, each voxel mean weighed by the endpoints it stands for.
-    // Empty when too little is left or the wall is too short.
-    [[nodiscard]] std::optional<Wall> Fit(const std::vector<Piece>& pieces,
-                                          const std::vector<size_t>& group) const {
+    // Empty when too little is left or the wall is too short. `group` is in key order.
+    [[nodiscard]] std::optional<Wall> Fit(const std::vector<const Piece*>& group,
+                                          const PartKey& first) const {
         std::vector<openvdb::Coord> voxels;
         std::vector<Eigen::Vector3d> points;
-        for (size_t a : group) {
-            voxels.insert(voxels.end(), pieces[a].voxels.begin(), pieces[a].voxels.end());
-            points.insert(points.end(), pieces[a].points.begin(), pieces[a].points.end());
+        for (const Piece* piece : group) {
+            voxels.insert(voxels.end(), piece->voxels.begin(), piece->voxels.end());
+            points.insert(points.end(), piece->points.begin(), piece->points.end());
         }
-        Plane plane =
-            RansacPlane(points, threshold_, config_.ransac_iterations, config_.seed + group[0])
-                .plane;
+        // The wall's seed is drawn apart from its first part's (which has number 1 + part).
+        Plane plane = RansacPlane(points, threshold_, config_.ransac_iterations,
+                                  SeedOf(config_.seed, first.cluster,
+                                         (uint64_t{1} << 32) + static_cast<uint64_t>(first.part)))
+                          .plane;
         core::EndpointReader hits(map_);
         std::vector<Eigen::Vector3d> near;
         std::vector<double> weights;
@@ -294,13 +312,12 @@ public:
         wall.centroid = fit.centroid;
         wall.inliers = inliers.size();
         wall.rms_m = fit.rms;
-        wall.slant_deg = SlantDeg(wall.normal, result_.up);
-        wall.slant_to_ground_deg = SlantDeg(wall.normal, result_.ground.normal);
-        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal, result_.up);
+        wall.slant_deg = SlantDeg(wall.normal, up_);
+        wall.lean_azimuth_deg = LeanAzimuthDeg(wall.normal, up_);
         // The fit's own one-sigma treats voxels as independent and misses what windows and
         // recesses do; the spread of the pieces' own slants catches that (robustly: MAD).
         std::vector<double> piece_slants;
-        for (size_t a : group) piece_slants.push_back(SlantDeg(pieces[a].plane.normal, result_.up));
+        for (const Piece* piece : group) piece_slants.push_back(SlantDeg(piece->plane.normal, up_));
         wall.uncertainty_deg = std::max(SlantUncertaintyDeg(fit), SpreadOfMean(piece_slants));
         wall.eigen_ratio = XyEigenRatio(inliers);
         wall.parts = static_cast<int>(group.size());
@@ -321,16 +338,162 @@ public:
         return wall;
     }
 
-private:
+    void Add(const std::vector<std::vector<openvdb::Coord>>& groups) {
+        auto t = Clock::now();
+        const auto parts = Parts(groups);
+        stats_.seconds_clustering += Seconds(t);
+        t = Clock::now();
+        std::vector<Judged> judged(parts.size());
+        core::ParallelFor(parts.size(),
+                          [&](size_t p) { judged[p] = Judge(parts[p].first, parts[p].second); });
+        for (size_t p = 0; p < parts.size(); ++p) {
+            parts_.emplace_back(parts[p].first, std::move(judged[p].part));
+            if (judged[p].piece) pieces_.emplace_back(parts[p].first, std::move(*judged[p].piece));
+        }
+        stats_.seconds_fitting += Seconds(t);
+    }
+
+    // The pieces in groups that are one wall (pieces linked through OneWall), each in key
+    // order, the groups in order of their first piece.
+    [[nodiscard]] std::vector<std::vector<size_t>> Merge() {
+        std::sort(pieces_.begin(), pieces_.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        UnionFind sets(pieces_.size());
+        for (size_t a = 0; a < pieces_.size(); ++a) {
+            for (size_t b = a + 1; b < pieces_.size(); ++b) {
+                if (OneWall(pieces_[a].second, pieces_[b].second)) {
+                    sets.Join(static_cast<int>(a), static_cast<int>(b));
+                }
+            }
+        }
+        std::vector<std::vector<size_t>> members(pieces_.size());
+        for (size_t a = 0; a < pieces_.size(); ++a) {
+            members[sets.Find(static_cast<int>(a))].push_back(a);
+        }
+        members.erase(
+            std::remove_if(members.begin(), members.end(), [](const auto& g) { return g.empty(); }),
+            members.end());
+        std::sort(members.begin(), members.end());
+        return members;
+    }
+
+    void FitSettled(const std::function<bool(const openvdb::CoordBBox&)>& open) {
+        const auto t = Clock::now();
+        std::vector<std::vector<size_t>> settled;
+        std::vector<bool> fitted(pieces_.size(), false);
+        for (std::vector<size_t>& group : Merge()) {
+            const bool waits = open && std::any_of(group.begin(), group.end(), [&](size_t a) {
+                                   return open(Reach(pieces_[a].second));
+                               });
+            if (waits) continue;
+            for (size_t a : group) fitted[a] = true;
+            settled.push_back(std::move(group));
+        }
+        std::vector<std::optional<Wall>> walls(settled.size());
+        core::ParallelFor(settled.size(), [&](size_t g) {
+            std::vector<const Piece*> group;
+            for (size_t a : settled[g]) group.push_back(&pieces_[a].second);
+            walls[g] = Fit(group, pieces_[settled[g].front()].first);
+        });
+        for (size_t g = 0; g < settled.size(); ++g) {
+            if (walls[g])
+                walls_.emplace_back(pieces_[settled[g].front()].first, std::move(*walls[g]));
+        }
+        size_t kept = 0;
+        for (size_t a = 0; a < pieces_.size(); ++a) {
+            if (fitted[a]) continue;
+            if (kept != a) pieces_[kept] = std::move(pieces_[a]);
+            ++kept;
+        }
+        pieces_.resize(kept);
+        stats_.seconds_fitting += Seconds(t);
+    }
+
+    [[nodiscard]] std::vector<openvdb::CoordBBox> PendingBoxes() const {
+        std::vector<openvdb::CoordBBox> boxes;
+        for (const auto& [key, piece] : pieces_) {
+            openvdb::CoordBBox box;
+            for (const openvdb::Coord& c : piece.voxels) box.expand(c);
+            boxes.push_back(box);
+        }
+        return boxes;
+    }
+
+    WallResult Finish(WallResult result) {
+        FitSettled({});
+        result.voxel_size = s_;
+        result.up = up_;
+        result.walls.clear();
+        result.parts.clear();
+        result.stats.candidate_voxels = stats_.candidate_voxels;
+        result.stats.clusters = stats_.clusters;
+        result.stats.noise_voxels = stats_.noise_voxels;
+        result.stats.seconds_clustering = stats_.seconds_clustering;
+        result.stats.seconds_fitting = stats_.seconds_fitting;
+        // Parts by cluster (numbered in order of their first voxel), walls by inliers.
+        std::stable_sort(parts_.begin(), parts_.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+        int cluster = -1;
+        for (size_t p = 0; p < parts_.size(); ++p) {
+            if (p == 0 || parts_[p].first.cluster != parts_[p - 1].first.cluster) ++cluster;
+            parts_[p].second.cluster = cluster;
+            result.parts.push_back(std::move(parts_[p].second));
+        }
+        std::sort(walls_.begin(), walls_.end(), [](const auto& a, const auto& b) {
+            return a.second.inliers != b.second.inliers ? a.second.inliers > b.second.inliers
+                                                        : a.first < b.first;
+        });
+        for (auto& [key, wall] : walls_) {
+            wall.id = static_cast<int>(result.walls.size() + 1);
+            wall.slant_to_ground_deg = SlantDeg(wall.normal, result.ground.normal);
+            result.walls.push_back(std::move(wall));
+        }
+        parts_.clear();
+        walls_.clear();
+        return result;
+    }
+
     const core::VoxelMap& map_;
     const openvdb::BoolGrid* observed_free_;  // null: the occupancy says what was seen free
     const WallConfig& config_;
-    WallResult& result_;
+    Eigen::Vector3d up_;
+    WallStats stats_;
     double s_;
     double threshold_;
+    std::vector<std::pair<PartKey, WallPart>> parts_;
+    std::vector<std::pair<PartKey, Piece>> pieces_;  // accepted parts not fitted yet
+    std::vector<std::pair<PartKey, Wall>> walls_;    // by their first piece's key
 };
 
-}  // namespace
+WallAssembler::WallAssembler(const core::VoxelMap& map, const WallConfig& config,
+                             const Eigen::Vector3d& up, const openvdb::BoolGrid* observed_free) {
+    config.Validate();
+    if (!map.occupancy) throw InvalidArgumentError("walls: the map has no occupancy grid");
+    impl_ = std::make_unique<Impl>(map, config, up, observed_free);
+}
+
+WallAssembler::~WallAssembler() = default;
+
+void WallAssembler::Add(const std::vector<std::vector<openvdb::Coord>>& groups) {
+    for (const auto& g : groups) impl_->stats_.candidate_voxels += g.size();
+    impl_->Add(groups);
+}
+
+void WallAssembler::FitSettled(const std::function<bool(const openvdb::CoordBBox&)>& open) {
+    impl_->FitSettled(open);
+}
+
+size_t WallAssembler::fitted() const { return impl_->walls_.size(); }
+
+std::vector<openvdb::CoordBBox> WallAssembler::PendingBoxes() const {
+    return impl_->PendingBoxes();
+}
+
+WallResult WallAssembler::Finish(WallResult voted) { return impl_->Finish(std::move(voted)); }
+
+Eigen::Vector3d UpOf(const WallConfig& config, const GroundPlane& ground) {
+    return config.level_to_ground ? ground.normal : Eigen::Vector3d::UnitZ();
+}
 
 WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     config.Validate();
@@ -354,48 +517,9 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
 WallResult FindWallsAmong(const core::VoxelMap& map, const std::vector<openvdb::Coord>& candidates,
                           WallResult voted, const WallConfig& config,
                           const openvdb::BoolGrid* observed_free) {
-    config.Validate();
-    if (!map.occupancy) throw InvalidArgumentError("walls: the map has no occupancy grid");
-    WallResult result = std::move(voted);
-    result.voxel_size = map.voxel_size;
-    result.walls.clear();
-    result.parts.clear();
-    result.up = config.level_to_ground ? result.ground.normal : Eigen::Vector3d::UnitZ();
-    result.stats.candidate_voxels = candidates.size();
-    result.stats.clusters = result.stats.noise_voxels = 0;
-    Pipeline pipeline(map, observed_free, config, result);
-
-    // 2. DBSCAN, then K-means inside each cluster.
-    auto t = Clock::now();
-    const auto parts = pipeline.Parts(candidates);
-    result.stats.seconds_clustering = Seconds(t);
-
-    // 3. The wall tests per part, merging, one fit per wall. Parts and walls are judged and
-    // fitted in parallel, each on its own seed, and taken in order: the result does not depend
-    // on the threads.
-    t = Clock::now();
-    std::vector<Pipeline::Judged> judged(parts.size());
-    core::ParallelFor(parts.size(), [&](size_t p) {
-        judged[p] = pipeline.Judge(parts[p].first, parts[p].second, config.seed + p);
-    });
-    std::vector<Piece> pieces;
-    for (Pipeline::Judged& j : judged) {
-        result.parts.push_back(j.part);
-        if (j.piece) pieces.push_back(std::move(*j.piece));
-    }
-    judged.clear();
-    const std::vector<std::vector<size_t>> groups = pipeline.Merge(pieces);
-    std::vector<std::optional<Wall>> fitted(groups.size());
-    core::ParallelFor(groups.size(),
-                      [&](size_t g) { fitted[g] = pipeline.Fit(pieces, groups[g]); });
-    for (std::optional<Wall>& wall : fitted) {
-        if (wall) result.walls.push_back(std::move(*wall));
-    }
-    std::sort(result.walls.begin(), result.walls.end(),
-              [](const Wall& a, const Wall& b) { return a.inliers > b.inliers; });
-    for (size_t w = 0; w < result.walls.size(); ++w) result.walls[w].id = static_cast<int>(w + 1);
-    result.stats.seconds_fitting = Seconds(t);
-    return result;
+    WallAssembler walls(map, config, UpOf(config, voted.ground), observed_free);
+    walls.Add(geometry::ConnectedVoxels(candidates, config.dbscan_eps_voxels));
+    return walls.Finish(std::move(voted));
 }
 
 }  // namespace strata::walls

@@ -3,6 +3,7 @@
 // of known tilt, and the whole pipeline on a hand-made map.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -90,6 +91,81 @@ TEST(Dbscan, FindsTwoBlocksAndLeavesIsolatedVoxelsAsNoise) {
     EXPECT_EQ(label[41], kNoise);
     EXPECT_EQ(label[42], kNoise);
     EXPECT_THROW((void)Dbscan(voxels, 0.5, 4), InvalidArgumentError);
+}
+
+// Voxels within eps of each other share a group; DBSCAN of each group alone labels its voxels as
+// DBSCAN of all of them does (the same partition into clusters and noise).
+TEST(ConnectedVoxels, GroupsWhatDbscanCanJoinAndNothingMore) {
+    std::vector<Coord> voxels;
+    for (int x = 0; x < 6; ++x)
+        for (int z = 0; z < 6; ++z) voxels.emplace_back(x, 0, z);  // a block
+    for (int x = 8; x < 12; ++x)
+        for (int z = 0; z < 6; ++z) voxels.emplace_back(x, 0, z);  // 3 voxels on: another
+    voxels.emplace_back(30, 0, 0);                                 // alone
+    voxels.emplace_back(5, 0, 7);  // 2 voxels above the first block's corner: joins it
+    std::reverse(voxels.begin(), voxels.end());
+    const auto groups = geometry::ConnectedVoxels(voxels, 2.0);
+    ASSERT_EQ(groups.size(), 3u);
+    EXPECT_EQ(groups[0].size(), 37u);
+    EXPECT_EQ(groups[1].size(), 24u);
+    EXPECT_EQ(groups[2], std::vector<Coord>{Coord(30, 0, 0)});
+    for (const auto& g : groups) EXPECT_TRUE(std::is_sorted(g.begin(), g.end()));
+    EXPECT_EQ(geometry::ConnectedVoxels(voxels, 3.0).size(), 2u) << "3 voxels apart: joined";
+
+    std::vector<Coord> sorted = voxels;
+    std::sort(sorted.begin(), sorted.end());
+    const std::vector<int> all = Dbscan(sorted, 2.0, 6);
+    size_t at = 0;
+    for (const auto& g : groups) {
+        const std::vector<int> own = Dbscan(g, 2.0, 6);
+        for (size_t n = 0; n < g.size(); ++n) {
+            const size_t in_all = static_cast<size_t>(
+                std::lower_bound(sorted.begin(), sorted.end(), g[n]) - sorted.begin());
+            EXPECT_EQ(own[n] == kNoise, all[in_all] == kNoise) << g[n];
+            // Same cluster in the group as its first voxel <=> the same in all.
+            const size_t first = static_cast<size_t>(
+                std::lower_bound(sorted.begin(), sorted.end(), g[0]) - sorted.begin());
+            if (own[n] != kNoise && own[0] != kNoise) {
+                EXPECT_EQ(own[n] == own[0], all[in_all] == all[first]) << g[n];
+            }
+        }
+        at += g.size();
+    }
+    EXPECT_EQ(at, voxels.size());
+    EXPECT_THROW((void)geometry::ConnectedVoxels(voxels, 0.5), InvalidArgumentError);
+}
+
+// The ground's sample: at most kMaxColumns columns, the same ones and the same plane whatever
+// order the columns come in, and every column of a smaller map.
+TEST(GroundSample, KeepsTheSameColumnsInAnyOrder) {
+    constexpr int kSide = 300;  // 90,000 columns: more than a sample holds
+    std::vector<std::pair<int, int>> columns;
+    for (int j = 0; j < kSide; ++j)
+        for (int i = 0; i < kSide; ++i) columns.emplace_back(i, j);
+    // A ground sloping 1 deg up along x.
+    const auto lowest = [](int i, int j) {
+        return Eigen::Vector3d(0.2 * i, 0.2 * j, 0.2 * i * std::tan(1.0 * kRad));
+    };
+    GroundSample forward, shuffled, small;
+    for (const auto& [i, j] : columns) {
+        if (forward.Admits(i, j)) forward.Add(i, j, lowest(i, j));
+    }
+    std::shuffle(columns.begin(), columns.end(), std::mt19937_64(7));
+    for (const auto& [i, j] : columns) shuffled.Add(i, j, lowest(i, j));
+    EXPECT_EQ(forward.entries().size(), GroundSample::kMaxColumns);
+    EXPECT_EQ(forward.InRasterOrder(), shuffled.InRasterOrder());
+    const std::vector<Eigen::Vector3d> sample = forward.InRasterOrder();
+    EXPECT_TRUE(std::is_sorted(sample.begin(), sample.end(), [](const auto& a, const auto& b) {
+        return a.y() != b.y() ? a.y() < b.y() : a.x() < b.x();
+    }));
+    // Spread over the map, not bunched: a quarter of the map holds about a quarter.
+    const auto in_quarter = std::count_if(sample.begin(), sample.end(), [](const auto& p) {
+        return p.x() < 0.2 * kSide / 2 && p.y() < 0.2 * kSide / 2;
+    });
+    EXPECT_NEAR(static_cast<double>(in_quarter) / sample.size(), 0.25, 0.01);
+    EXPECT_NEAR(FitGround(forward, 0.2).tilt_deg, 1.0, 1e-6);
+    for (int i = 0; i < 10; ++i) small.Add(i, 0, lowest(i, 0));
+    EXPECT_EQ(small.entries().size(), 10u);
 }
 
 TEST(KMeans, SeparatesThreeBlobsAndFollowsTheStudysRule) {

@@ -3,6 +3,7 @@
 // box with the background, which for the boxes tiles use (unbounded in z) builds and prunes
 // nodes across the whole index range: seconds per call. These touch only the leaves there are.
 
+#include <limits>
 #include <vector>
 
 #include "strata/core/GridTypes.hpp"
@@ -12,6 +13,31 @@ namespace strata::core {
 /// @brief `box` grown by `halo` voxels in x and y (tile boxes span every z already).
 inline openvdb::CoordBBox GrownXY(const openvdb::CoordBBox& box, int halo) {
     return {box.min().offsetBy(-halo, -halo, 0), box.max().offsetBy(halo, halo, 0)};
+}
+
+/// @brief Calls fn(voxels, value) for every active voxel (a box of one) and active tile of `grid`
+/// in the columns of `box` (its x/y; z is not tested), visiting only the leaves that overlap
+/// them: a few tiles' worth of work in a grid of many. A tile may reach outside the columns.
+template <typename GridT, typename Fn>
+void ForEachActiveInColumns(const GridT& grid, const openvdb::CoordBBox& box, Fn&& fn) {
+    constexpr int32_t kLowest = std::numeric_limits<int32_t>::min();
+    constexpr int32_t kHighest = std::numeric_limits<int32_t>::max();
+    const openvdb::CoordBBox columns(openvdb::Coord(box.min().x(), box.min().y(), kLowest),
+                                     openvdb::Coord(box.max().x(), box.max().y(), kHighest));
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+        if (!columns.hasOverlap(leaf->getNodeBoundingBox())) continue;
+        for (auto v = leaf->cbeginValueOn(); v; ++v) {
+            if (columns.isInside(v.getCoord()))
+                fn(openvdb::CoordBBox(v.getCoord(), v.getCoord()), *v);
+        }
+    }
+    // Active tiles above the leaves (pruned uniform regions), without visiting every voxel.
+    auto tiles = grid.tree().cbeginValueOn();
+    tiles.setMaxDepth(GridT::TreeType::ValueOnCIter::LEAF_DEPTH - 1);
+    for (; tiles; ++tiles) {
+        const openvdb::CoordBBox voxels = tiles.getBoundingBox();
+        if (columns.hasOverlap(voxels)) fn(voxels, *tiles);
+    }
 }
 
 /// @brief Adds the active voxels of `from` inside `box` (values and states) to `into`, which

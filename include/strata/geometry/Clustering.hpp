@@ -20,6 +20,16 @@ inline constexpr int kNoise = -1;
 [[nodiscard]] std::vector<int> Dbscan(const std::vector<openvdb::Coord>& voxels, double eps_voxels,
                                       int min_points);
 
+/// @brief The voxels in groups that DBSCAN with this `eps_voxels` can never join: two voxels
+/// within `eps_voxels` of each other are in one group. DBSCAN of a group on its own gives that
+/// group the clusters and noise DBSCAN of all the voxels gives it when both take the voxels in
+/// Coord's order (up to the clusters' numbers).
+/// @return the groups, each sorted (Coord's order, duplicates dropped), in order of their first
+/// voxel.
+/// @throw InvalidArgumentError unless eps_voxels >= 1.
+[[nodiscard]] std::vector<std::vector<openvdb::Coord>> ConnectedVoxels(
+    std::vector<openvdb::Coord> voxels, double eps_voxels);
+
 /// @brief Lloyd's K-means with k-means++ seeding (deterministic for a seed). k is clamped to
 /// [1, points.size()].
 /// @return one cluster index in [0, k) per point; empty for no points.

@@ -54,6 +54,8 @@ public:
 
 private:
     struct Cache;
+    /// The snapshot's version of the tile's fused grids (nullptr when it holds none).
+    [[nodiscard]] const TileVersion* Version(const TileKey& key) const;
     TileReader(const MapStore& store, Snapshot snapshot, std::shared_ptr<Cache> cache);
     const MapStore* store_;
     Snapshot snapshot_;

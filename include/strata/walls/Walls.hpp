@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -163,15 +165,36 @@ inline constexpr int kObservedSideReachVoxels = 3;
 /// observed-side test looks from a voxel (2 voxels along the normal from its mean).
 [[nodiscard]] int HaloVoxels(double voxel_size, const WallConfig& config);
 
-/// @brief The ground plane from the mean of the lowest occupied voxel of every occupied column,
-/// in raster order (j, then i), as EstimateGround takes them from a ColumnGrid.
-[[nodiscard]] GroundPlane FitGround(std::vector<Eigen::Vector3d> lowest, double voxel_size,
-                                    uint64_t seed = 1);
+/// @brief The columns the ground plane is fitted to: of the occupied columns' lowest voxels, the
+/// kMaxColumns whose column hashes lowest (all of them on a smaller map). Which columns those
+/// are depends on nothing but the columns, so a map read in parts, in any order, keeps only
+/// these and samples as the whole map does.
+class GroundSample {
+public:
+    static constexpr size_t kMaxColumns = 50000;  ///< a sample is plenty for one plane
+    struct Entry {
+        uint64_t hash;
+        int32_t j, i;
+        double x, y, z;  ///< the mean of the column's lowest voxel (map frame)
+    };
+    /// @brief Whether column (i, j) would be kept now (so its mean need not be computed else).
+    [[nodiscard]] bool Admits(int32_t i, int32_t j) const;
+    /// @brief Offers column (i, j) and the mean of its lowest voxel; each column once.
+    void Add(int32_t i, int32_t j, const Eigen::Vector3d& lowest);
+    /// @brief Offers a column another sample kept.
+    void Add(const Entry& e);
+    /// @brief The kept columns (in no particular order), e.g. to send them to another process.
+    [[nodiscard]] const std::vector<Entry>& entries() const { return heap_; }
+    /// @brief The kept columns' means in raster order (j, then i).
+    [[nodiscard]] std::vector<Eigen::Vector3d> InRasterOrder() const;
 
-/// @brief Which of `columns` lowest voxels FitGround fits the plane to (all up to 50,000, else an
-/// even sample of 50,000), in order: FitGround of exactly these gives the same plane, so a map
-/// read in parts need only keep the columns' keys and compute the means of the sample.
-[[nodiscard]] std::vector<size_t> GroundSample(size_t columns);
+private:
+    std::vector<Entry> heap_;  // a max-heap by (hash, j, i): its top is the first to go
+};
+
+/// @brief The ground plane of the sampled lowest voxels: RANSAC with a one-voxel threshold.
+[[nodiscard]] GroundPlane FitGround(const GroundSample& sample, double voxel_size,
+                                    uint64_t seed = 1);
 
 /// @brief Stage 1 (voting): the occupied voxels of the columns whose window votes for walls,
 /// minus the ground at the bottom of the window. `window` is columns.Window(radius).
@@ -186,10 +209,52 @@ inline constexpr int kObservedSideReachVoxels = 3;
 /// occupancy.
 [[nodiscard]] WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config = {});
 
-/// @brief The stages after voting (DBSCAN, K-means, the wall tests, merging, one fit per wall)
-/// on `candidates` in the order VoteCandidates gives them (the occupancy tree's). `voted` brings
-/// stage 1's ground and counts. `map` needs the endpoints and labels of the candidates and the
-/// occupancy within HaloVoxels of them, nothing else: FindWalls(map) is
+/// @brief The stages after voting (DBSCAN, K-means, the wall tests, merging, one fit per wall),
+/// fed the candidates a few connected groups at a time, as a map read tile by tile yields them,
+/// or all at once (FindWallsAmong): the walls do not depend on how the candidates were split or
+/// in which order the groups came. Every stage takes voxels in Coord's order and draws its seed
+/// from them (K-means from its cluster's first voxel, RANSAC also from the part's number in it),
+/// clusters are numbered in order of their first voxel, and walls are ordered by inliers, then
+/// by their first part.
+class WallAssembler {
+public:
+    /// `map` must hold the endpoints and labels of every candidate added and not fitted yet,
+    /// and the occupancy within HaloVoxels of them (or `observed_free` those of them seen free,
+    /// as for FindWallsAmong); the rest of it is never read. Slants are measured against `up`
+    /// (UpOf).
+    /// @throw InvalidArgumentError for a bad config or a map without occupancy.
+    WallAssembler(const core::VoxelMap& map, const WallConfig& config, const Eigen::Vector3d& up,
+                  const openvdb::BoolGrid* observed_free = nullptr);
+    ~WallAssembler();
+    WallAssembler(const WallAssembler&) = delete;
+    WallAssembler& operator=(const WallAssembler&) = delete;
+
+    /// @brief DBSCAN, K-means and the wall tests on whole groups of
+    /// geometry::ConnectedVoxels(candidates, config.dbscan_eps_voxels), in parallel.
+    void Add(const std::vector<std::vector<openvdb::Coord>>& groups);
+    /// @brief Merges and fits the walls none of whose pieces comes within merge_gap_m (and a
+    /// voxel) of a voxel box `open` says more candidates may still come to.
+    void FitSettled(const std::function<bool(const openvdb::CoordBBox&)>& open);
+    /// @brief How many walls have been fitted so far (each kept until Finish).
+    [[nodiscard]] size_t fitted() const;
+    /// @brief The voxel boxes of the accepted parts not fitted yet: what `map` must still hold.
+    [[nodiscard]] std::vector<openvdb::CoordBBox> PendingBoxes() const;
+    /// @brief Fits what is left; the result, with stage 1's ground and counts from `voted`.
+    /// Call once.
+    [[nodiscard]] WallResult Finish(WallResult voted);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// @brief What slants are measured against: the map's z axis, or with `level_to_ground` the
+/// ground's normal.
+[[nodiscard]] Eigen::Vector3d UpOf(const WallConfig& config, const GroundPlane& ground);
+
+/// @brief The stages after voting on `candidates` (any order): one WallAssembler fed them all.
+/// `voted` brings stage 1's ground and counts. `map` needs the endpoints and labels of the
+/// candidates and the occupancy within HaloVoxels of them, nothing else: FindWalls(map) is
 /// FindWallsAmong(map, VoteCandidates(...), ...), and a map read tile by tile gives the same
 /// walls from only those voxels (pipeline::FindWalls). Only whether a voxel was seen free
 /// (occupancy <= 0) is read of the occupancy: `observed_free`, when given, holds those voxels
