@@ -2,7 +2,7 @@
 
 #include <cstdint>
 
-#include "Bytes.hpp"
+#include "strata/core/Bytes.hpp"
 
 namespace strata::pipeline::detail {
 namespace {
@@ -65,17 +65,17 @@ std::string EncodeWindows(const std::vector<vehicles::WindowVehicles>& found,
         candidates += w.candidates, faces += w.occluder_faces;
     }
     std::string out;
-    Put(out, static_cast<uint64_t>(ground_columns));
-    Put(out, candidates);
-    Put(out, faces);
-    PutVector(out, cars);
-    PutVector(out, cleared);
-    PutVector(out, refilled);
+    core::Put(out, static_cast<uint64_t>(ground_columns));
+    core::Put(out, candidates);
+    core::Put(out, faces);
+    core::PutVector(out, cars);
+    core::PutVector(out, cleared);
+    core::PutVector(out, refilled);
     return out;
 }
 
 vehicles::WindowVehicles DecodeWindows(const std::string& bytes, size_t& ground_columns) {
-    Reader in(bytes, "vehicles");
+    core::ByteReader in(bytes, "vehicles");
     vehicles::WindowVehicles w;
     ground_columns += in.Get<uint64_t>();
     w.candidates = in.Get<uint64_t>();

@@ -201,7 +201,7 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
                     if (c.voxels > 0) {
                         ++kept.voting_columns;
                     } else {
-                        kept.voting_empty.emplace_back(i, j);
+                        kept.voting_empty.emplace_back(i, j, 0);
                     }
                 }
             }
@@ -237,7 +237,7 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
 size_t KeptBytes(const WallsKept& kept) {
     size_t bytes = kept.observed_free->memUsage() + kept.candidates.capacity() * sizeof(Coord) +
                    kept.ground.entries().capacity() * sizeof(walls::GroundSample::Entry) +
-                   kept.voting_empty.capacity() * sizeof(std::pair<int32_t, int32_t>);
+                   kept.voting_empty.capacity() * sizeof(Coord);
     for (const auto& grid : kept.map.Grids()) bytes += grid->memUsage();
     return bytes;
 }
@@ -260,16 +260,17 @@ void KeepOnly(GridT& grid, const std::vector<CoordBBox>& live) {
     openvdb::tools::pruneInactive(grid.tree());
 }
 
-// After the groups up to the tile `last` (in key order) were read: hands the candidates whose
+// After the groups from the tile `first` up to `last` (in key order) were read: hands the
+// candidates whose
 // every neighbour within DBSCAN's reach has been read to the later stages, fits the walls no
 // candidate still to come can join, and drops the voxels nothing waiting needs any more.
-void HandOn(const store::MapSettings& settings, const TileKey& last,
+void HandOn(const store::MapSettings& settings, const TileKey& first, const TileKey& last,
             const walls::WallConfig& config, WallsKept& kept, walls::WallAssembler& assembler) {
-    // Groups are consecutive tiles in key order (x, then y): a box's tiles have all been read
-    // when its last one, (largest x, largest y), has.
+    // This process reads the tiles from `first` to `last` in key order (x, then y): a box's
+    // tiles have all been read here when its first one, (smallest x, smallest y), and its last
+    // one, (largest x, largest y), lie between them.
     const auto read = [&](const CoordBBox& box) {
-        const TileKey hi = settings.TileOf(box.max());
-        return !(last < hi);
+        return !(settings.TileOf(box.min()) < first) && !(last < settings.TileOf(box.max()));
     };
     const int reach = static_cast<int>(std::floor(config.dbscan_eps_voxels));
     std::vector<std::vector<Coord>> done;
@@ -300,6 +301,12 @@ void HandOn(const store::MapSettings& settings, const TileKey& last,
     KeepOnly(*kept.map.endpoints, live);
     KeepOnly(*kept.map.label, live);
     KeepOnly(*kept.observed_free, live);
+}
+
+// The groups rank r reads: a run of consecutive ones, the runs of about equal length.
+std::pair<size_t, size_t> RunOfRank(size_t groups, const Ranks& ranks) {
+    const auto n = static_cast<size_t>(ranks.size()), r = static_cast<size_t>(ranks.rank());
+    return {groups * r / n, groups * (r + 1) / n};
 }
 
 // The budget groups are split by: on several ranks at most an even share of the map (so that
@@ -335,36 +342,45 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     const store::TileReader reader(map, snapshot, 0);
     WallsKept kept;
     kept.map = map.EmptyMap();
-    // One process hands each group's finished candidates on as it goes (slants against the
-    // map's z axis need nothing of the later groups); on several ranks, or levelled to a ground
-    // still unknown, rank 0 takes them all at the end.
-    const bool streamed = ranks.size() == 1 && !config.level_to_ground;
+    // Each rank reads a run of consecutive groups and hands the finished candidates on as it
+    // goes (slants against the map's z axis need nothing of the later groups); what touches
+    // another rank's tiles waits for rank 0, which takes every rank's leftovers at the end.
+    // Levelled to a ground still unknown, everything waits for the end.
+    const bool streamed = !config.level_to_ground;
     std::optional<walls::WallAssembler> assembler;
     if (streamed)
         assembler.emplace(kept.map, config, Eigen::Vector3d::UnitZ(), kept.observed_free.get());
-    size_t mine = 0, kept_bytes = 0;
+    const auto [begin, end] = RunOfRank(split.size(), ranks);
+    size_t kept_bytes = 0;
     std::chrono::steady_clock::duration handing_on{};  // the later stages' share of the loop
     OnEveryRank(ranks, [&] {
-        for (size_t g = static_cast<size_t>(ranks.rank()); g < split.size();
-             g += static_cast<size_t>(ranks.size())) {
+        for (size_t g = begin; g < end; ++g) {
             CollectGroup(reader, settings, split[g], groups, halo, config, kept);
-            ++mine;
             kept_bytes = std::max(kept_bytes, KeptBytes(kept));
             if (!streamed) continue;
             const auto t = std::chrono::steady_clock::now();
-            HandOn(settings, split[g].back(), config, kept, *assembler);
+            HandOn(settings, split[begin].front(), split[g].back(), config, kept, *assembler);
             handing_on += std::chrono::steady_clock::now() - t;
         }
     });
     if (ranks.size() > 1) {
-        const std::vector<std::string> all = ranks.Gather(ranks.root() ? "" : EncodeKept(kept));
+        // Each rank's leftovers: its waiting candidates and what they read, its parts, walls and
+        // waiting pieces.
+        std::string leftovers;
+        if (!ranks.root()) {
+            leftovers = EncodeKept(kept, assembler ? assembler->Release() : std::string());
+        }
+        const std::vector<std::string> all = ranks.Gather(leftovers);
         if (!ranks.root()) {
             WallsOutcome outcome;
             outcome.commit = snapshot.commit;
-            outcome.tile_groups = mine;
+            outcome.tile_groups = end - begin;
             return outcome;
         }
-        for (size_t r = 1; r < all.size(); ++r) MergeKept(all[r], kept);
+        for (size_t r = 1; r < all.size(); ++r) {
+            const std::string released = MergeKept(all[r], kept);
+            if (assembler) assembler->Absorb(released);
+        }
         kept_bytes = std::max(kept_bytes, KeptBytes(kept));
     }
 
@@ -372,8 +388,8 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     voted.voxel_size = settings.voxel_size_m;
     voted.stats.occupied_columns = kept.occupied_columns;
     voted.stats.voting_columns = kept.voting_columns;
-    for (const auto& [i, j] : kept.voting_empty) {
-        voted.stats.voting_columns += kept.occupied.isInside(Coord(i, j, 0));
+    for (const Coord& column : kept.voting_empty) {
+        voted.stats.voting_columns += kept.occupied.isInside(column);
     }
     voted.ground = walls::FitGround(kept.ground, settings.voxel_size_m, config.seed);
     voted.stats.seconds_columns =

@@ -1,6 +1,6 @@
 // walls' stage 1 per group of tiles keeps a WallsKept; under mpirun each rank sends its own to
-// rank 0 as bytes: the counts and columns as flat records (Bytes.hpp), the grids as one OpenVDB
-// stream.
+// rank 0 as bytes: the counts and columns as flat records (core/Bytes.hpp), the grids as one
+// OpenVDB stream.
 #include "WallsKept.hpp"
 
 #include <openvdb/io/Stream.h>
@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "Bytes.hpp"
+#include "strata/core/Bytes.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::pipeline::detail {
@@ -40,15 +40,16 @@ void MergeVoxels(const GridT& from, GridT& into) {
 
 }  // namespace
 
-std::string EncodeKept(const WallsKept& k) {
+std::string EncodeKept(const WallsKept& k, const std::string& released) {
     std::string out;
-    Put(out, k.occupied_columns);
-    Put(out, k.voting_columns);
-    Put(out, k.occupied.min());
-    Put(out, k.occupied.max());
-    PutVector(out, k.ground.entries());
-    PutVector(out, k.voting_empty);
-    PutVector(out, k.candidates);
+    core::Put(out, k.occupied_columns);
+    core::Put(out, k.voting_columns);
+    core::Put(out, k.occupied.min());
+    core::Put(out, k.occupied.max());
+    core::PutVector(out, k.ground.entries());
+    core::PutVector(out, k.voting_empty);
+    core::PutVector(out, k.candidates);
+    core::PutBytes(out, released);
     openvdb::GridPtrVec grids = k.map.Grids();
     k.observed_free->setName(kObservedFreeGrid);
     grids.push_back(k.observed_free);
@@ -57,8 +58,8 @@ std::string EncodeKept(const WallsKept& k) {
     return out + os.str();
 }
 
-void MergeKept(const std::string& bytes, WallsKept& into) {
-    Reader in(bytes, "walls");
+std::string MergeKept(const std::string& bytes, WallsKept& into) {
+    core::ByteReader in(bytes, "walls");
     into.occupied_columns += in.Get<size_t>();
     into.voting_columns += in.Get<size_t>();
     const Coord lo = in.Get<Coord>(), hi = in.Get<Coord>();
@@ -67,10 +68,11 @@ void MergeKept(const std::string& bytes, WallsKept& into) {
         into.occupied.expand(hi);
     }
     for (const auto& e : in.GetVector<walls::GroundSample::Entry>()) into.ground.Add(e);
-    for (const auto& e : in.GetVector<std::pair<int32_t, int32_t>>()) {
+    for (const auto& e : in.GetVector<Coord>()) {
         into.voting_empty.push_back(e);
     }
     for (const Coord& c : in.GetVector<Coord>()) into.candidates.push_back(c);
+    std::string released = in.GetBytes();
     std::istringstream is(in.Rest(), std::ios_base::binary);
     openvdb::io::Stream stream(is, /*delayLoad=*/false);
     openvdb::GridPtrVec grids = *stream.getGrids();
@@ -86,6 +88,7 @@ void MergeKept(const std::string& bytes, WallsKept& into) {
     const core::VoxelMap map = core::VoxelMap::FromGrids(grids);
     MergeVoxels(*map.label, *into.map.label);
     MergeVoxels(*map.endpoints, *into.map.endpoints);
+    return released;
 }
 
 }  // namespace strata::pipeline::detail

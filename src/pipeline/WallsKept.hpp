@@ -22,18 +22,18 @@ struct WallsKept {
     /// The voxels seen free within walls::kObservedSideReachVoxels of a candidate: all the later
     /// stages read of the occupancy, in a BoolGrid's memory.
     openvdb::BoolGrid::Ptr observed_free = openvdb::BoolGrid::create(false);
-    walls::GroundSample ground;  ///< the lowest voxels the ground plane is fitted to
-    std::vector<std::pair<int32_t, int32_t>> voting_empty;  // voting columns with no voxel
-    openvdb::CoordBBox occupied;                            // columns with an occupied voxel
+    walls::GroundSample ground;                ///< the lowest voxels the ground plane is fitted to
+    std::vector<openvdb::Coord> voting_empty;  // voting columns (z 0) with no voxel
+    openvdb::CoordBBox occupied;               // columns with an occupied voxel
     size_t occupied_columns = 0, voting_columns = 0;
 };
 
-/// @brief A rank's WallsKept in bytes.
-[[nodiscard]] std::string EncodeKept(const WallsKept& kept);
-/// @brief Adds one rank's EncodeKept to rank 0's. The ranks' candidates lie in their own tiles;
-/// what two ranks both kept (the occupancy near a border) holds the same values, so the union
-/// does not depend on the order of the ranks.
+/// @brief A rank's WallsKept in bytes, with what its walls::WallAssembler released.
+[[nodiscard]] std::string EncodeKept(const WallsKept& kept, const std::string& released);
+/// @brief Adds one rank's EncodeKept to rank 0's; returns what its assembler released. The
+/// ranks' candidates lie in their own tiles; what two ranks both kept (the occupancy near a
+/// border) holds the same values, so the union does not depend on the order of the ranks.
 /// @throw FormatError when the bytes are cut short or lack a grid.
-void MergeKept(const std::string& bytes, WallsKept& into);
+[[nodiscard]] std::string MergeKept(const std::string& bytes, WallsKept& into);
 
 }  // namespace strata::pipeline::detail

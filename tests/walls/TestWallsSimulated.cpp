@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <memory>
 
 #include "TempPath.hpp"
 #include "WallEval.hpp"
+#include "strata/core/Error.hpp"
 #include "strata/geometry/Clustering.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
@@ -138,17 +140,19 @@ void ExpectSameWalls(const WallResult& a, const WallResult& b) {
 
 // The stages after voting fed `candidates` in strips of `strip_voxels` along x, each wall fitted
 // as soon as no later strip can join it, as a map read tile by tile feeds them. `strips_fitting`:
-// how many strips fitted a wall.
+// how many strips fitted a wall. After `hand_over` strips (0: never) a second assembler takes over
+// what the first released, as rank 0 takes the other ranks'.
 WallResult InStrips(const core::VoxelMap& map, const std::vector<openvdb::Coord>& candidates,
                     const WallResult& voted, const WallConfig& config, int strip_voxels,
-                    size_t* strips_fitting) {
+                    size_t* strips_fitting, size_t hand_over = 0) {
     std::vector<std::vector<openvdb::Coord>> waiting =
         geometry::ConnectedVoxels(candidates, config.dbscan_eps_voxels);
     const int reach = static_cast<int>(config.dbscan_eps_voxels);
     openvdb::CoordBBox all;
     for (const openvdb::Coord& c : candidates) all.expand(c);
-    WallAssembler assembler(map, config, UpOf(config, voted.ground));
+    auto assembler = std::make_unique<WallAssembler>(map, config, UpOf(config, voted.ground));
     *strips_fitting = 0;
+    size_t strips = 0;
     for (int line = all.min().x() + strip_voxels; !waiting.empty(); line += strip_voxels) {
         // The candidates left of `line` are known: the groups that reach no further are ready.
         std::vector<std::vector<openvdb::Coord>> ready, still;
@@ -164,16 +168,21 @@ WallResult InStrips(const core::VoxelMap& map, const std::vector<openvdb::Coord>
             }
         }
         waiting = std::move(still);
-        assembler.Add(ready);
-        const size_t before = assembler.fitted();
-        assembler.FitSettled([&](const openvdb::CoordBBox& box) {
+        assembler->Add(ready);
+        const size_t before = assembler->fitted();
+        assembler->FitSettled([&](const openvdb::CoordBBox& box) {
             return box.max().x() >= line ||
                    std::any_of(boxes.begin(), boxes.end(),
                                [&](const openvdb::CoordBBox& b) { return b.hasOverlap(box); });
         });
-        *strips_fitting += assembler.fitted() > before;
+        *strips_fitting += assembler->fitted() > before;
+        if (++strips == hand_over) {
+            auto next = std::make_unique<WallAssembler>(map, config, UpOf(config, voted.ground));
+            next->Absorb(assembler->Release());
+            assembler = std::move(next);
+        }
     }
-    return assembler.Finish(voted);
+    return assembler->Finish(voted);
 }
 
 // Stage 1 as FindWalls runs it: the ground and the candidates.
@@ -199,12 +208,14 @@ TEST(WallAssembler, CandidatesInStripsGiveTheWholeMapsWalls) {
     size_t strips_fitting = 0;
     ExpectSameWalls(InStrips(map, candidates, voted, config, 40, &strips_fitting), whole);
     EXPECT_GE(strips_fitting, 5u) << "walls fitted strip by strip, not all at the end";
+    // Handed over half way: the walls fitted, the parts judged and the pieces waiting go along.
+    ExpectSameWalls(InStrips(map, candidates, voted, config, 40, &strips_fitting, 8), whole);
 }
 
-// A wall 16 m long and 5 m high cut by a 0.6 m slot: the slot is wider than DBSCAN's reach, so
-// its halves are two clusters, and narrower than the merge gap, so they are one wall. A half
-// read before the other must wait for it.
-TEST(WallAssembler, AWallCutByASlotWaitsForItsOtherHalf) {
+// A street side with a wall 16 m long and 5 m high cut by a 0.6 m slot at x = 8 m: the slot is
+// wider than DBSCAN's reach, so its halves are two clusters, and narrower than the merge gap,
+// so they are one wall.
+core::VoxelMap SlottedWall() {
     constexpr double kVoxel = 0.2;
     core::VoxelMap map = core::VoxelMap::Create(kVoxel);
     auto occ = map.occupancy->getAccessor();
@@ -225,6 +236,12 @@ TEST(WallAssembler, AWallCutByASlotWaitsForItsOtherHalf) {
     for (auto it = openvdb::CoordBBox(lo, hi).begin(); it; ++it) {
         if (!occ.isValueOn(*it)) occ.setValueOn(*it, -1.0f);
     }
+    return map;
+}
+
+// A half of the slotted wall read before the other must wait for it.
+TEST(WallAssembler, AWallCutByASlotWaitsForItsOtherHalf) {
+    const core::VoxelMap map = SlottedWall();
     const WallConfig config;
     const WallResult whole = FindWalls(map, config);
     ASSERT_EQ(whole.walls.size(), 1u);
@@ -234,6 +251,36 @@ TEST(WallAssembler, AWallCutByASlotWaitsForItsOtherHalf) {
     const std::vector<openvdb::Coord> candidates = Candidates(map, config, voted);
     size_t strips_fitting = 0;
     ExpectSameWalls(InStrips(map, candidates, voted, config, 20, &strips_fitting), whole);
+}
+
+// What one assembler releases another takes over (as rank 0 takes the other ranks'): the
+// slotted wall's left half judged by one, its right half by another that absorbed the first's
+// parts and waiting piece, is the whole map's wall.
+TEST(WallAssembler, WhatOneReleasesAnotherTakesOver) {
+    const core::VoxelMap map = SlottedWall();
+    const WallConfig config;
+    const WallResult whole = FindWalls(map, config);
+    WallResult voted;
+    std::vector<std::vector<openvdb::Coord>> left, right;
+    for (auto& group :
+         geometry::ConnectedVoxels(Candidates(map, config, voted), config.dbscan_eps_voxels)) {
+        (group.back().x() < map.WorldToVoxel({8.0, 0.0, 0.0}).x() ? left : right)
+            .push_back(std::move(group));
+    }
+    ASSERT_FALSE(left.empty());
+    ASSERT_FALSE(right.empty());
+    WallAssembler first(map, config, UpOf(config, voted.ground));
+    first.Add(left);
+    first.FitSettled([&](const openvdb::CoordBBox& box) {
+        return box.max().x() >= map.WorldToVoxel({8.0, 0.0, 0.0}).x();
+    });
+    ASSERT_FALSE(first.PendingBoxes().empty()) << "the left half waits for the right";
+    WallAssembler second(map, config, UpOf(config, voted.ground));
+    second.Absorb(first.Release());
+    EXPECT_TRUE(first.PendingBoxes().empty());
+    second.Add(right);
+    ExpectSameWalls(second.Finish(voted), whole);
+    EXPECT_THROW(second.Absorb("short"), FormatError);
 }
 
 INSTANTIATE_TEST_SUITE_P(VoxelSizes, WallsSimulated, ::testing::ValuesIn(kVoxelSizes),

@@ -239,6 +239,13 @@ public:
     [[nodiscard]] size_t fitted() const;
     /// @brief The voxel boxes of the accepted parts not fitted yet: what `map` must still hold.
     [[nodiscard]] std::vector<openvdb::CoordBBox> PendingBoxes() const;
+    /// @brief What was added and not finished (parts, fitted walls, pieces still waiting) as
+    /// bytes for another process's assembler of the same job (Absorb); leaves this one empty.
+    [[nodiscard]] std::string Release();
+    /// @brief Takes over what another assembler released: its parts and walls as they are, its
+    /// waiting pieces as this one's (`map` must hold what they read).
+    /// @throw FormatError when the bytes are cut short.
+    void Absorb(const std::string& bytes);
     /// @brief Fits what is left; the result, with stage 1's ground and counts from `voted`.
     /// Call once.
     [[nodiscard]] WallResult Finish(WallResult voted);
