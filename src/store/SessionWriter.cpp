@@ -2,6 +2,7 @@
 
 #include <openvdb/tools/Prune.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -214,12 +215,21 @@ struct SessionWriter::State {
         if (!l.file.empty()) ++stats.layers_written;
     }
 
-    // Moves the least recently used tiles out of memory until the working set is under 3/4 of
-    // the budget; the tiles the current scan touched stay.
-    void Evict(const std::set<TileKey>& keep) {
+    // What the tiles in memory may take of the budget: the rest is kept for a scan's marks,
+    // which each thread makes in a bitmap of up to dense_scratch_limit_bytes (at most half of
+    // the budget is set aside).
+    [[nodiscard]] size_t WorkingSetBudget() const {
         const size_t budget = options.memory_budget_bytes;
+        const auto threads = static_cast<size_t>(tbb::this_task_arena::max_concurrency());
+        return budget - std::min(budget / 2, threads * config.dense_scratch_limit_bytes);
+    }
+
+    // Moves the least recently used tiles out of memory until the working set is under 3/4 of
+    // its budget; the tiles the current scan touched stay.
+    void Evict(const std::set<TileKey>& keep) {
         // Without a budget the working set only grows: Commit measures its peak once.
-        if (budget == 0) return;
+        if (options.memory_budget_bytes == 0) return;
+        const size_t budget = WorkingSetBudget();
         const size_t bytes = MemoryBytes();
         stats.peak_memory_bytes = std::max(stats.peak_memory_bytes, bytes);
         if (bytes <= budget) return;

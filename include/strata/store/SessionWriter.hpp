@@ -19,7 +19,9 @@ struct SessionOptions {
     std::string notes;
     Eigen::Matrix4d alignment = Eigen::Matrix4d::Identity();
     /// Tiles in memory are evicted (written to their next version, read back when a later scan
-    /// touches them) to stay under this many bytes; 0 keeps every touched tile in memory.
+    /// touches them) to stay under this many bytes, less what a scan's marks may take (each
+    /// thread's bitmap of up to IntegrationConfig::dense_scratch_limit_bytes, at most half the
+    /// budget); 0 keeps every touched tile in memory.
     size_t memory_budget_bytes = 0;
     /// The tiles this writer keeps (empty: every tile). When several processes share a session
     /// (`mpirun`, docs/scale.md), each keeps its own and leaves the rest of every update to
