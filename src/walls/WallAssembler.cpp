@@ -445,8 +445,7 @@ struct WallAssembler::Impl {
         for (const auto& [key, p] : parts_) {
             parts.push_back({Flat(key), static_cast<int32_t>(p.verdict),
                              static_cast<int32_t>(p.dominant_class), p.voxels, p.inliers,
-                             p.eigen_ratio, p.slant_deg, p.height_m, p.length_m,
-                             Flat(p.centroid)});
+                             p.eigen_ratio, p.slant_deg, p.height_m, p.length_m, Flat(p.centroid)});
         }
         core::PutVector(out, parts);
         core::Put(out, static_cast<uint64_t>(pieces_.size()));
