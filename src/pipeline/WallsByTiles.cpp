@@ -1,9 +1,11 @@
-// Walls tile by tile: stage 1 (column statistics, voting, the ground's lowest voxels) runs per
-// group of tiles with a halo of walls::HaloVoxels; what the later stages read (the candidates'
-// endpoints and labels, the occupancy within reach of them) is kept in one sparse map, and the
-// later stages run once on the union of every group's candidates. Walls across tile borders are
-// therefore joined by DBSCAN itself, and the result does not depend on the order of the groups:
-// the candidates are taken in the occupancy tree's order, the lowest voxels in raster order.
+// Walls tile by tile (docs/walls.md, "Tile by tile"): stage 1 (column statistics, voting, the
+// ground's sample) runs per group of tiles with a halo of walls::HaloVoxels, the groups in key
+// order. After each group the candidates no unread tile can change go on to the later stages
+// (walls::WallAssembler), and walls no candidate to come can join are fitted; what is kept across
+// groups (the waiting candidates' endpoints and labels, the voxels seen free near them) is the
+// front between read and unread tiles. On several ranks each rank does this over a run of groups
+// and rank 0 finishes what waits at the runs' borders. Seeds and orders come from the voxels, so
+// the walls are the whole map's whatever the grouping.
 #include "WallsByTiles.hpp"
 
 #include <openvdb/tools/Morphology.h>
@@ -350,7 +352,9 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     std::optional<walls::WallAssembler> assembler;
     if (streamed)
         assembler.emplace(kept.map, config, Eigen::Vector3d::UnitZ(), kept.observed_free.get());
-    const auto [begin, end] = RunOfRank(split.size(), ranks);
+    // Not a structured binding: clang (C++17) does not let the lambda below capture one.
+    const std::pair<size_t, size_t> run = RunOfRank(split.size(), ranks);
+    const size_t begin = run.first, end = run.second;
     size_t kept_bytes = 0;
     std::chrono::steady_clock::duration handing_on{};  // the later stages' share of the loop
     OnEveryRank(ranks, [&] {

@@ -14,13 +14,13 @@ namespace strata::pipeline {
 
 /// @brief The snapshot analysed and the walls found in it.
 struct WallsOutcome {
-    /// The snapshot's fused map when read whole; tile by tile, only the candidates' endpoints
-    /// and labels (no occupancy).
+    /// The snapshot's fused map when read whole; tile by tile, only what the last waiting
+    /// candidates read (their endpoints and labels; no occupancy).
     core::VoxelMap map;
     walls::WallResult result;
     int64_t commit = 0;      ///< the snapshot's commit
     size_t tile_groups = 0;  ///< groups of tiles read one after another; 0: read whole
-    size_t kept_bytes = 0;   ///< tile by tile: memory of what was kept across groups
+    size_t kept_bytes = 0;   ///< tile by tile: the most memory kept across groups at once
 };
 
 /// @brief Finds the walls of the snapshot (walls::FindWalls). A snapshot whose decoded tiles fit
@@ -34,7 +34,7 @@ struct WallsOutcome {
                                      const walls::WallConfig& config,
                                      size_t memory_budget_bytes = size_t{512} << 20);
 
-/// @brief FindWalls on the ranks of mpirun (docs/scale.md), each rank reading its share of the
+/// @brief FindWalls on the ranks of mpirun (docs/scale.md), each rank reading a run of the
 /// groups of tiles of the snapshot rank 0 passes (the others' `snapshot` is not read): rank 0
 /// gets the walls, bit for bit those of one process, and the other ranks an outcome without
 /// walls. On one rank, FindWalls. Every rank must call it.
