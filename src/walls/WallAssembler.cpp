@@ -8,8 +8,8 @@
 #include <optional>
 #include <utility>
 
+#include "Handover.hpp"
 #include "Pieces.hpp"
-#include "strata/core/Bytes.hpp"
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/ParallelFor.hpp"
@@ -47,40 +47,6 @@ using detail::SpreadOfMean;
 using detail::Support;
 using detail::TowardsObservedSide;
 using detail::UnionFind;
-
-// Records of what one assembler hands another (plain values: Eigen's vectors as three doubles).
-struct FlatKey {
-    int32_t x, y, z, part;
-};
-struct Flat3 {
-    double x, y, z;
-};
-struct FlatPart {
-    FlatKey key;
-    int32_t verdict, dominant_class;
-    uint64_t voxels, inliers;
-    double eigen_ratio, slant_deg, height_m, length_m;
-    Flat3 centroid;
-};
-struct FlatPiece {
-    FlatKey key;
-    Flat3 normal, centroid, lo, hi;
-    double d;
-    uint64_t inliers;
-};
-struct FlatWall {
-    FlatKey key;
-    Flat3 centroid, normal;
-    double slant_deg, d, area_m2, rms_m, uncertainty_deg, lean_azimuth_deg, length_m, height_m,
-        eigen_ratio;
-    uint64_t inliers;
-    int32_t parts;
-};
-
-FlatKey Flat(const PartKey& k) { return {k.cluster.x(), k.cluster.y(), k.cluster.z(), k.part}; }
-PartKey Unflat(const FlatKey& k) { return {openvdb::Coord(k.x, k.y, k.z), k.part}; }
-Flat3 Flat(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-Eigen::Vector3d Unflat(const Flat3& v) { return {v.x, v.y, v.z}; }
 
 // A seed drawn from a voxel and a number (splitmix64 of each in turn): the same wherever the
 // voxel's group of candidates was read.
@@ -435,35 +401,7 @@ struct WallAssembler::Impl {
     }
 
     std::string Release() {
-        std::string out;
-        core::Put(out, stats_.candidate_voxels);
-        core::Put(out, stats_.clusters);
-        core::Put(out, stats_.noise_voxels);
-        core::Put(out, stats_.seconds_clustering);
-        core::Put(out, stats_.seconds_fitting);
-        std::vector<FlatPart> parts;
-        for (const auto& [key, p] : parts_) {
-            parts.push_back({Flat(key), static_cast<int32_t>(p.verdict),
-                             static_cast<int32_t>(p.dominant_class), p.voxels, p.inliers,
-                             p.eigen_ratio, p.slant_deg, p.height_m, p.length_m, Flat(p.centroid)});
-        }
-        core::PutVector(out, parts);
-        core::Put(out, static_cast<uint64_t>(pieces_.size()));
-        for (const auto& [key, p] : pieces_) {
-            core::Put(out, FlatPiece{Flat(key), Flat(p.plane.normal), Flat(p.centroid), Flat(p.lo),
-                                     Flat(p.hi), p.plane.d, p.inliers});
-            core::PutVector(out, p.voxels);
-            std::vector<Flat3> points;
-            for (const auto& q : p.points) points.push_back(Flat(q));
-            core::PutVector(out, points);
-        }
-        core::Put(out, static_cast<uint64_t>(walls_.size()));
-        for (const auto& [key, w] : walls_) {
-            core::Put(out, FlatWall{Flat(key), Flat(w.centroid), Flat(w.normal), w.slant_deg, w.d,
-                                    w.area_m2, w.rms_m, w.uncertainty_deg, w.lean_azimuth_deg,
-                                    w.length_m, w.height_m, w.eigen_ratio, w.inliers, w.parts});
-            core::PutVector(out, w.voxels);
-        }
+        std::string out = detail::EncodeHandover(stats_, parts_, pieces_, walls_);
         stats_ = {};
         parts_.clear();
         pieces_.clear();
@@ -472,56 +410,7 @@ struct WallAssembler::Impl {
     }
 
     void Absorb(const std::string& bytes) {
-        core::ByteReader in(bytes, "walls");
-        stats_.candidate_voxels += in.Get<size_t>();
-        stats_.clusters += in.Get<size_t>();
-        stats_.noise_voxels += in.Get<size_t>();
-        stats_.seconds_clustering += in.Get<double>();
-        stats_.seconds_fitting += in.Get<double>();
-        for (const FlatPart& f : in.GetVector<FlatPart>()) {
-            WallPart p;
-            p.verdict = static_cast<PartVerdict>(f.verdict);
-            p.dominant_class = static_cast<core::SemanticClass>(f.dominant_class);
-            p.voxels = f.voxels;
-            p.inliers = f.inliers;
-            p.eigen_ratio = f.eigen_ratio;
-            p.slant_deg = f.slant_deg;
-            p.height_m = f.height_m;
-            p.length_m = f.length_m;
-            p.centroid = Unflat(f.centroid);
-            parts_.emplace_back(Unflat(f.key), p);
-        }
-        for (auto n = in.Get<uint64_t>(); n > 0; --n) {
-            const auto f = in.Get<FlatPiece>();
-            Piece p;
-            p.plane = {Unflat(f.normal), f.d};
-            p.centroid = Unflat(f.centroid);
-            p.lo = Unflat(f.lo);
-            p.hi = Unflat(f.hi);
-            p.inliers = f.inliers;
-            p.voxels = in.GetVector<openvdb::Coord>();
-            for (const Flat3& q : in.GetVector<Flat3>()) p.points.push_back(Unflat(q));
-            pieces_.emplace_back(Unflat(f.key), std::move(p));
-        }
-        for (auto n = in.Get<uint64_t>(); n > 0; --n) {
-            const auto f = in.Get<FlatWall>();
-            Wall w;
-            w.centroid = Unflat(f.centroid);
-            w.normal = Unflat(f.normal);
-            w.slant_deg = f.slant_deg;
-            w.d = f.d;
-            w.area_m2 = f.area_m2;
-            w.rms_m = f.rms_m;
-            w.uncertainty_deg = f.uncertainty_deg;
-            w.lean_azimuth_deg = f.lean_azimuth_deg;
-            w.length_m = f.length_m;
-            w.height_m = f.height_m;
-            w.eigen_ratio = f.eigen_ratio;
-            w.inliers = f.inliers;
-            w.parts = f.parts;
-            w.voxels = in.GetVector<openvdb::Coord>();
-            walls_.emplace_back(Unflat(f.key), std::move(w));
-        }
+        detail::DecodeHandover(bytes, stats_, parts_, pieces_, walls_);
     }
 
     const core::VoxelMap& map_;
