@@ -5,15 +5,11 @@
 #include <cmath>
 #include <cstdint>
 
+#include "strata/core/Hash.hpp"
+
 namespace strata::sim::detail {
 
-/// SplitMix64 finaliser: a bijective 64-bit mix with good avalanche.
-[[nodiscard]] inline uint64_t Mix64(uint64_t x) {
-    x += 0x9E3779B97F4A7C15ULL;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-    return x ^ (x >> 31);
-}
+using core::Mix64;
 
 /// Key from several integers (seed, scan, ray, ...).
 [[nodiscard]] inline uint64_t HashKey(uint64_t a, uint64_t b, uint64_t c = 0) {

@@ -45,7 +45,8 @@ Eigen::Vector3d Unflat(const Flat3& v) { return {v.x, v.y, v.z}; }
 
 }  // namespace
 
-std::string EncodeHandover(const WallStats& stats, const std::vector<std::pair<PartKey, WallPart>>& parts,
+std::string EncodeHandover(const WallStats& stats,
+                           const std::vector<std::pair<PartKey, WallPart>>& parts,
                            const std::vector<std::pair<PartKey, Piece>>& pieces,
                            const std::vector<std::pair<PartKey, Wall>>& walls) {
     std::string out;
@@ -57,8 +58,8 @@ std::string EncodeHandover(const WallStats& stats, const std::vector<std::pair<P
     std::vector<FlatPart> flat;
     for (const auto& [key, p] : parts) {
         flat.push_back({Flat(key), static_cast<int32_t>(p.verdict),
-                         static_cast<int32_t>(p.dominant_class), p.voxels, p.inliers,
-                         p.eigen_ratio, p.slant_deg, p.height_m, p.length_m, Flat(p.centroid)});
+                        static_cast<int32_t>(p.dominant_class), p.voxels, p.inliers, p.eigen_ratio,
+                        p.slant_deg, p.height_m, p.length_m, Flat(p.centroid)});
     }
     core::PutVector(out, flat);
     core::Put(out, static_cast<uint64_t>(pieces.size()));
@@ -79,7 +80,6 @@ std::string EncodeHandover(const WallStats& stats, const std::vector<std::pair<P
     }
     return out;
 }
-
 
 void DecodeHandover(const std::string& bytes, WallStats& stats,
                     std::vector<std::pair<PartKey, WallPart>>& parts,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "strata/core/GridBox.hpp"
+#include "strata/core/Hash.hpp"
 #include "strata/geometry/PlaneFit.hpp"
 #include "strata/walls/Walls.hpp"
 
@@ -84,11 +85,7 @@ GroundPlane EstimateGround(const core::VoxelMap& map, const columns::ColumnGrid&
 namespace {
 
 uint64_t ColumnHash(int32_t i, int32_t j) {
-    uint64_t z = (uint64_t{static_cast<uint32_t>(i)} << 32) | static_cast<uint32_t>(j);
-    z += 0x9E3779B97F4A7C15ull;  // splitmix64
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
+    return core::Mix64((uint64_t{static_cast<uint32_t>(i)} << 32) | static_cast<uint32_t>(j));
 }
 
 bool Before(const GroundSample::Entry& a, const GroundSample::Entry& b) {

@@ -12,6 +12,7 @@
 #include "Pieces.hpp"
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/Hash.hpp"
 #include "strata/core/ParallelFor.hpp"
 #include "strata/geometry/Clustering.hpp"
 #include "strata/geometry/PlaneFit.hpp"
@@ -48,18 +49,12 @@ using detail::Support;
 using detail::TowardsObservedSide;
 using detail::UnionFind;
 
-// A seed drawn from a voxel and a number (splitmix64 of each in turn): the same wherever the
+// A seed drawn from a voxel and a number (SplitMix64 of each in turn): the same wherever the
 // voxel's group of candidates was read.
 uint64_t SeedOf(uint64_t seed, const openvdb::Coord& c, uint64_t n) {
-    auto mix = [](uint64_t z) {
-        z += 0x9E3779B97F4A7C15ull;
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    };
-    uint64_t h = mix(seed);
-    for (const int32_t v : {c.x(), c.y(), c.z()}) h = mix(h ^ static_cast<uint32_t>(v));
-    return mix(h ^ n);
+    uint64_t h = core::Mix64(seed);
+    for (const int32_t v : {c.x(), c.y(), c.z()}) h = core::Mix64(h ^ static_cast<uint32_t>(v));
+    return core::Mix64(h ^ n);
 }
 
 }  // namespace
