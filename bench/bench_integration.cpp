@@ -3,7 +3,10 @@
 // when any voxel differs from OctoMap's (state, or log-odds by more than 1e-5).
 //
 //   bench_integration [DATA_DIR] [--scans N] [--voxel S ...] [--strata-only] [--counts] [--ci]
+//                     [--narrow]
 //
+// --narrow: walk one ray at a time where the processor could walk four (IntegrationConfig's
+// wide_walk off), to measure what the wide walk is worth.
 // --counts: also DDA steps and unique voxels per scan (for callgrind's instructions per step).
 // --ci: a short run (the first 10 BALM and 3 KITTI 00 scans at 0.2 m) that also exits 1 when a
 // row's speed-up falls below the documented short-run value / 2.5 or its memory ratio to OctoMap
@@ -114,10 +117,12 @@ Run RunOctomap(const std::vector<WorldScan>& scans, octomap::OcTree& tree) {
     return {1e3 * seconds / scans.size(), tree.memoryUsage() / 1e6, 0.0};
 }
 
-Run RunStrata(const std::vector<WorldScan>& scans, int threads, strata::core::VoxelMap& map) {
+Run RunStrata(const std::vector<WorldScan>& scans, int threads, bool wide,
+              strata::core::VoxelMap& map) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     strata::integration::IntegrationConfig config;
     config.max_range_m = kMaxRange;
+    config.wide_walk = wide;
     strata::integration::Integrator integrator(map, config);
     double seconds = 0.0, unique = 0.0;
     for (const auto& s : scans) {
@@ -149,12 +154,15 @@ int main(int argc, char** argv) {
     std::vector<double> voxels;
     bool with_octomap = true;  // --strata-only: one thread, no OctoMap (for callgrind)
     bool counts = false, ci = false;
+    bool wide = true;  // --narrow: walk one ray at a time even where four at a time can
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--scans" && i + 1 < argc) {
             max_scans = std::stoul(argv[++i]);
         } else if (a == "--strata-only") {
             with_octomap = false;
+        } else if (a == "--narrow") {
+            wide = false;
         } else if (a == "--counts") {
             counts = true;
         } else if (a == "--ci") {
@@ -185,9 +193,9 @@ int main(int argc, char** argv) {
             octomap::OcTree tree(voxel);
             const Run octo = with_octomap ? RunOctomap(scans, tree) : Run{};
             auto map = strata::core::VoxelMap::Create(voxel);
-            const Run one = RunStrata(scans, 1, map);
+            const Run one = RunStrata(scans, 1, wide, map);
             auto map2 = strata::core::VoxelMap::Create(voxel);
-            const Run two = with_octomap ? RunStrata(scans, 2, map2) : one;
+            const Run two = with_octomap ? RunStrata(scans, 2, wide, map2) : one;
             const double pts_per_scan = static_cast<double>(n_points) / scans.size();
             const double speedup = octo.ms_per_scan / one.ms_per_scan;
             double jaccard_occ = 0.0, jaccard_free = 0.0;

@@ -86,7 +86,7 @@ bool FindBricks(const VoxelBox& box, const std::vector<const uint64_t*>& bitmaps
     return all != 0;
 }
 
-ScanMasks MarkDense(const PreparedScan& scan) {
+ScanMasks MarkDense(const PreparedScan& scan, bool wide) {
     const VoxelBox& box = scan.box;
     const auto n_bytes = static_cast<size_t>(box.size() / 8);
     tbb::enumerable_thread_specific<Bitmap> free_bits([n_bytes] { return Bitmap(n_bytes); });
@@ -96,7 +96,11 @@ ScanMasks MarkDense(const PreparedScan& scan) {
                           const auto mark = [bits](int64_t pos) {
                               bits[pos >> 6] |= uint64_t{1} << (pos & 63);
                           };
-                          TraceRays(scan, range, mark, bits);
+                          if (wide) {
+                              TraceRaysWide(scan, range, bits);
+                          } else {
+                              TraceRays(scan, range, mark, bits);
+                          }
                       });
     Bitmap occupied_bits(n_bytes);
     for (const int64_t pos : scan.endpoint_pos) occupied_bits.Set(pos);
@@ -234,7 +238,7 @@ void RequireSparseMarkingFits(const PreparedScan& scan, const IntegrationConfig&
 
 ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config) {
     if (static_cast<uint64_t>(scan.box.size() / 8) <= config.dense_scratch_limit_bytes) {
-        return MarkDense(scan);
+        return MarkDense(scan, config.wide_walk && WideWalkAvailable());
     }
     // Only a scan too large for the dense scratch can be too large for memory.
     RequireSparseMarkingFits(scan, config);

@@ -76,47 +76,26 @@ inline void StepsWithoutTests(int64_t k, double (&t)[3], const double (&d)[3], C
     t[0] = t0, t[1] = t1, t[2] = t2;
 }
 
-// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel, then every voxel the walk enters
-// until it enters the end voxel or a voxel it would leave beyond the ray's length (OctoMap's
-// guard against rounding near the end: such a voxel is not marked). The exit distance of the
-// current voxel is the smallest tMax, which is the one the walk steps on, so the guard costs one
-// comparison per step. The box check bounds every write, whatever the rounding does; the box's
-// padding of one voxel holds every voxel the walk can enter, so it never cuts a ray short.
-//
-// The first `steps - 4` steps skip all three tests, because none can fire there
-// (docs/integration.md, "Speed"): step k takes the k-th smallest crossing time of the three
-// axes. At least steps - 3 crossings lie a whole voxel before the end voxel's entry (all but
-// the last along each axis), far more than the float rounding (~1e-7 of the length), so every
-// voxel entered by then is left before the length, no crossing beyond the end's slab is taken
-// (the walk stays inside the key box of origin and end), and the end, reachable only at step
-// `steps`, is not. With `words` (the dense bitmap `mark` sets bits in), those steps go through a
-// WordCursor.
+// A walk's last steps, from voxel `pos` (marked already) with crossing times `t`: every voxel it
+// enters until it enters the end voxel or a voxel it would leave beyond the ray's length
+// (OctoMap's guard against rounding near the end: such a voxel is not marked). The exit distance
+// of the current voxel is the smallest tMax, which is the one the walk steps on, so the guard
+// costs one comparison per step. The box check bounds every write, whatever the rounding does;
+// the box's padding of one voxel holds every voxel the walk can enter, so it never cuts a ray
+// short.
 template <typename MarkFn>
-inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark, uint64_t* words) {
-    if (ray.start == ray.end) return;  // origin and end share a voxel: no free cells
+inline void StepsWithTests(int64_t pos, const double (&t)[3], const RaySetup& ray,
+                           uint64_t box_size, MarkFn&& mark) {
     // Locals, not members: the marks are stores the compiler cannot prove apart from `ray`, so
     // values read through `ray` would be reloaded after every store.
-    int64_t pos = ray.start;
     const int64_t end = ray.end;
     const int64_t s0 = ray.stride[0], s1 = ray.stride[1], s2 = ray.stride[2];
     const double d0 = ray.t_delta[0], d1 = ray.t_delta[1], d2 = ray.t_delta[2];
     const double length = ray.length;
-    double t[3] = {ray.t_max[0], ray.t_max[1], ray.t_max[2]};
-    const double d[3] = {d0, d1, d2};
-    mark(pos);  // OctoMap adds the origin's key before any test
-    if (words != nullptr) {
-        WordCursor at{words, pos >> 6, uint64_t{1} << (pos & 63), s0 / 64, s1 / 64, s2 > 0};
-        StepsWithoutTests(ray.steps - 4, t, d, at);
-        pos = at.Pos();
-    } else {
-        PosCursor<MarkFn> at{pos, s0, s1, s2, mark};
-        StepsWithoutTests(ray.steps - 4, t, d, at);
-        pos = at.Pos();
-    }
     double t0 = t[0], t1 = t[1], t2 = t[2];
     for (;;) {
         // The exit distance of voxel `pos` is the tMax the walk steps on: beyond the length, the
-        // voxel is not marked and the walk ends. (For the origin voxel, marked above, ending here
+        // voxel is not marked and the walk ends. (For the origin voxel, marked first, ending here
         // gives OctoMap's set too: exit distances never decrease along the walk.)
         if (t0 < t1) {
             if (t0 < t2) {
@@ -145,6 +124,37 @@ inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark, uint
     }
 }
 
+// The DDA of OcTreeBaseImpl::computeRayKeys: the origin voxel, then every voxel the walk enters
+// until StepsWithTests stops it.
+//
+// The first `steps - 4` steps skip all three tests, because none can fire there
+// (docs/integration.md, "Speed"): step k takes the k-th smallest crossing time of the three
+// axes. At least steps - 3 crossings lie a whole voxel before the end voxel's entry (all but
+// the last along each axis), far more than the float rounding (~1e-7 of the length), so every
+// voxel entered by then is left before the length, no crossing beyond the end's slab is taken
+// (the walk stays inside the key box of origin and end), and the end, reachable only at step
+// `steps`, is not. With `words` (the dense bitmap `mark` sets bits in), those steps go through a
+// WordCursor.
+template <typename MarkFn>
+inline void TraceRay(const RaySetup& ray, uint64_t box_size, MarkFn&& mark, uint64_t* words) {
+    if (ray.start == ray.end) return;  // origin and end share a voxel: no free cells
+    int64_t pos = ray.start;
+    const int64_t s0 = ray.stride[0], s1 = ray.stride[1], s2 = ray.stride[2];
+    double t[3] = {ray.t_max[0], ray.t_max[1], ray.t_max[2]};
+    const double d[3] = {ray.t_delta[0], ray.t_delta[1], ray.t_delta[2]};
+    mark(pos);  // OctoMap adds the origin's key before any test
+    if (words != nullptr) {
+        WordCursor at{words, pos >> 6, uint64_t{1} << (pos & 63), s0 / 64, s1 / 64, s2 > 0};
+        StepsWithoutTests(ray.steps - 4, t, d, at);
+        pos = at.Pos();
+    } else {
+        PosCursor<MarkFn> at{pos, s0, s1, s2, mark};
+        StepsWithoutTests(ray.steps - 4, t, d, at);
+        pos = at.Pos();
+    }
+    StepsWithTests(pos, t, ray, box_size, mark);
+}
+
 // Traces the rays of points `range` (dropped points have none) in the scan's number type.
 template <typename MarkFn>
 void TraceRays(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, MarkFn&& mark,
@@ -158,5 +168,13 @@ void TraceRays(const PreparedScan& scan, const tbb::blocked_range<size_t>& range
     };
     scan.float_rays ? trace(0.0f) : trace(0.0);
 }
+
+/// True when this processor can walk several rays at a time (AVX2).
+[[nodiscard]] bool WideWalkAvailable();
+
+/// TraceRays into the dense bitmap `words`, eight rays at a time in two sets of AVX2 registers
+/// (WideWalk.cpp); the same marks. Only where WideWalkAvailable.
+void TraceRaysWide(const PreparedScan& scan, const tbb::blocked_range<size_t>& range,
+                   uint64_t* words);
 
 }  // namespace strata::integration::detail

@@ -248,6 +248,12 @@ TEST(Integrator, SparseMarkingMatchesDenseMarking) {
     ExpectSameGrids(IntegrateRoom(IntegrationConfig{}), IntegrateRoom(sparse));
 }
 
+TEST(Integrator, WideWalkMatchesOneRayAtATime) {
+    IntegrationConfig narrow;
+    narrow.wide_walk = false;
+    ExpectSameGrids(IntegrateRoom(IntegrationConfig{}), IntegrateRoom(narrow));
+}
+
 TEST(Integrator, PointsOnlyMarksEndpointsWithoutFreeSpace) {
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     IntegrationConfig config;

@@ -33,6 +33,9 @@ struct IntegrationConfig {
     /// Per-thread budget of the dense scratch bitmap covering one scan's bounding box; scans whose
     /// box needs more are marked sparsely (slower, bounded memory).
     size_t dense_scratch_limit_bytes = size_t{64} << 20;
+    /// Walk four rays at a time where the processor has AVX2 (docs/integration.md, "Speed"); off:
+    /// one at a time. The same map either way.
+    bool wide_walk = true;
 
     /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;
