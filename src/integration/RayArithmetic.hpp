@@ -126,6 +126,15 @@ public:
         return ray;
     }
 
+    // What every ray shares, for a set-up of several rays at once (WideWalk.cpp).
+    [[nodiscard]] const PreparedScan& scan() const { return scan_; }
+    [[nodiscard]] const Vec3<T>& origin() const { return origin_; }
+    [[nodiscard]] int64_t start() const { return start_; }
+    [[nodiscard]] int64_t stride(int axis) const { return strides_[axis]; }
+    [[nodiscard]] double half() const { return half_; }
+    [[nodiscard]] double centre(int axis) const { return centre_[axis]; }
+    [[nodiscard]] double origin_d(int axis) const { return origin_d_[axis]; }
+
 private:
     const PreparedScan& scan_;
     Vec3<T> origin_;

@@ -1,4 +1,5 @@
-// Four rays' walks at a time, one per lane of AVX2 registers (docs/integration.md, "Speed").
+// Eight rays' walks at a time, one per lane of two sets of AVX2 registers (docs/integration.md,
+// "Speed").
 //
 // A walk's step picks the axis with the smallest crossing time. Taken one ray at a time, that
 // choice is a branch the processor mispredicts whenever a ray runs diagonally to the grid, which
@@ -6,7 +7,9 @@
 // time to advance and the stride to move by, so nothing branches on the data. Each lane does
 // IEEE double additions and comparisons, the very operations of StepsWithoutTests in the same
 // order with the same tie-breaking, so every lane enters the voxels its ray's scalar walk
-// enters: the map is the same bit for bit (tested against the scalar walk on real scans).
+// enters: the map is the same bit for bit (tested against OctoMap, and against the scalar walk).
+// The rays' set-ups are computed four at a time the same way (RayStarts<float>'s operations in
+// lanes: each IEEE operation rounds in a lane as it does alone, and none is fused).
 //
 // Lanes run the untested steps of their rays (TraceRay's `steps - 4`) in rounds as long as the
 // shortest lane's remainder; a lane whose ray has no untested step left finishes it alone with
@@ -14,6 +17,9 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <limits>
+#include <type_traits>
 
 #include "TraceRay.hpp"
 
@@ -49,11 +55,11 @@ __attribute__((target("avx2"))) inline __m256i LoadInts(const int64_t* p) {
 }
 
 __attribute__((target("avx2"))) inline Quad LoadQuad(const Lanes& lanes, int l0) {
-    return {_mm256_load_pd(lanes.t[0] + l0),  _mm256_load_pd(lanes.t[1] + l0),
-            _mm256_load_pd(lanes.t[2] + l0),  _mm256_load_pd(lanes.d[0] + l0),
-            _mm256_load_pd(lanes.d[1] + l0),  _mm256_load_pd(lanes.d[2] + l0),
-            LoadInts(lanes.pos + l0),             LoadInts(lanes.stride[0] + l0),
-            LoadInts(lanes.stride[1] + l0),       LoadInts(lanes.stride[2] + l0)};
+    return {_mm256_load_pd(lanes.t[0] + l0), _mm256_load_pd(lanes.t[1] + l0),
+            _mm256_load_pd(lanes.t[2] + l0), _mm256_load_pd(lanes.d[0] + l0),
+            _mm256_load_pd(lanes.d[1] + l0), _mm256_load_pd(lanes.d[2] + l0),
+            LoadInts(lanes.pos + l0),        LoadInts(lanes.stride[0] + l0),
+            LoadInts(lanes.stride[1] + l0),  LoadInts(lanes.stride[2] + l0)};
 }
 
 __attribute__((target("avx2"))) inline void StoreQuad(const Quad& q, Lanes& lanes, int l0) {
@@ -103,6 +109,71 @@ __attribute__((target("avx2"))) void Round(Lanes& lanes, int64_t steps, uint64_t
     StoreQuad(b, lanes, 4);
 }
 
+// The set-ups of four rays of a float scan, `index` (not dropped): RayStarts<float>::operator()
+// operation for operation, in lanes.
+__attribute__((target("avx2"))) void SetUpFour(const RayStarts<float>& starts,
+                                               const size_t (&index)[4], RaySetup (&out)[4]) {
+    const PreparedScan& scan = starts.scan();
+    alignas(32) double end[3][4];
+    for (int l = 0; l < 4; ++l) {
+        for (int a = 0; a < 3; ++a) end[a][l] = scan.ends[index[l]][a];
+    }
+    const __m256d inv = _mm256_set1_pd(scan.inv_voxel_size);
+    const __m256d zero = _mm256_setzero_pd();
+    const __m256d none = _mm256_set1_pd(std::numeric_limits<double>::max());
+    const __m256d magnitude = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff));
+    __m128 direction[3];
+    alignas(16) int32_t key[3][4];
+    for (int a = 0; a < 3; ++a) {
+        // The end as float (OctoMap's point3d), its key floor(end * 1/s) in double.
+        const __m128 e = _mm256_cvtpd_ps(_mm256_load_pd(end[a]));
+        const __m256d scaled = _mm256_mul_pd(_mm256_cvtps_pd(e), inv);
+        _mm_store_si128(reinterpret_cast<__m128i*>(key[a]),
+                        _mm256_cvttpd_epi32(_mm256_floor_pd(scaled)));
+        direction[a] = _mm_sub_ps(e, _mm_set1_ps(starts.origin()[a]));
+    }
+    // The length: squares summed in float, in Norm's order, the root in double, rounded to float.
+    const __m128 squares = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(direction[0], direction[0]), _mm_mul_ps(direction[1], direction[1])),
+        _mm_mul_ps(direction[2], direction[2]));
+    const __m128 length = _mm256_cvtpd_ps(_mm256_sqrt_pd(_mm256_cvtps_pd(squares)));
+    alignas(32) double t_max[3][4], t_delta[3][4], sign[3][4], lengths[4];
+    _mm256_store_pd(lengths, _mm256_cvtps_pd(length));
+    for (int a = 0; a < 3; ++a) {
+        const __m256d d = _mm256_cvtps_pd(_mm_div_ps(direction[a], length));
+        const __m256d up = _mm256_cmp_pd(d, zero, _CMP_GT_OQ);
+        const __m256d down = _mm256_cmp_pd(d, zero, _CMP_LT_OQ);
+        const __m256d moves = _mm256_or_pd(up, down);
+        const __m256d border =
+            _mm256_blendv_pd(_mm256_set1_pd(starts.centre(a) + -starts.half()),
+                             _mm256_set1_pd(starts.centre(a) + starts.half()), up);
+        const __m256d t =
+            _mm256_div_pd(_mm256_sub_pd(border, _mm256_set1_pd(starts.origin_d(a))), d);
+        const __m256d delta =
+            _mm256_div_pd(_mm256_set1_pd(scan.voxel_size), _mm256_and_pd(d, magnitude));
+        _mm256_store_pd(t_max[a], _mm256_blendv_pd(none, t, moves));
+        _mm256_store_pd(t_delta[a], _mm256_blendv_pd(none, delta, moves));
+        _mm256_store_pd(sign[a], _mm256_sub_pd(_mm256_and_pd(up, _mm256_set1_pd(1.0)),
+                                               _mm256_and_pd(down, _mm256_set1_pd(1.0))));
+    }
+    for (int l = 0; l < 4; ++l) {
+        RaySetup ray;
+        const openvdb::Coord key_end(key[0][l], key[1][l], key[2][l]);
+        ray.start = starts.start();
+        ray.end = scan.box.Index(key_end);
+        if (ray.start != ray.end) {
+            for (int a = 0; a < 3; ++a) {
+                ray.steps += std::abs(int64_t{key_end[a]} - scan.key_origin[a]);
+                ray.stride[a] = static_cast<int64_t>(sign[a][l]) * starts.stride(a);
+                ray.t_max[a] = t_max[a][l];
+                ray.t_delta[a] = t_delta[a][l];
+            }
+            ray.length = lengths[l];
+        }
+        out[l] = ray;
+    }
+}
+
 // The rest of lane `l`'s ray, alone: its untested steps left, then the tested ones.
 void Finish(const Lanes& lanes, int l, uint64_t box_size, uint64_t* words) {
     const RaySetup& ray = lanes.ray[l];
@@ -121,13 +192,35 @@ void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uin
     const Marker mark{words};
     Lanes lanes;
     size_t next = range.begin();
+    // The set-ups of the next rays, four at a time where the scan's rays are float.
+    RaySetup ready[4];
+    int n_ready = 0, taken = 0;
+    const auto next_ray = [&](RaySetup& ray) {
+        if (taken == n_ready) {
+            size_t index[4];
+            n_ready = taken = 0;
+            for (; next != range.end() && n_ready < 4; ++next) {
+                if (scan.kinds[next] != PointKind::kDropped) index[n_ready++] = next;
+            }
+            if constexpr (std::is_same_v<T, float>) {
+                if (n_ready == 4) {
+                    SetUpFour(starts, index, ready);
+                } else {
+                    for (int k = 0; k < n_ready; ++k) ready[k] = starts(index[k]);
+                }
+            } else {
+                for (int k = 0; k < n_ready; ++k) ready[k] = starts(index[k]);
+            }
+            if (n_ready == 0) return false;
+        }
+        ray = ready[taken++];
+        return true;
+    };
     // Puts the next ray with untested steps into lane `l` (rays without any are walked here);
     // false when the range has no ray left.
     const auto load = [&](int l) {
-        while (next != range.end()) {
-            const size_t i = next++;
-            if (scan.kinds[i] == PointKind::kDropped) continue;
-            const RaySetup ray = starts(i);
+        RaySetup ray;
+        while (next_ray(ray)) {
             if (ray.steps <= 4) {
                 TraceRay(ray, box_size, mark, nullptr);
                 continue;
