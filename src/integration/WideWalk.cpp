@@ -82,11 +82,11 @@ __attribute__((target("avx2"))) inline void Step(Quad& q, int64_t* word, uint64_
     q.t0 = _mm256_add_pd(q.t0, _mm256_and_pd(x, q.d0));
     q.t1 = _mm256_add_pd(q.t1, _mm256_and_pd(y, q.d1));
     q.t2 = _mm256_add_pd(q.t2, _mm256_andnot_pd(not_z, q.d2));
-    const __m256i step =
-        _mm256_or_si256(_mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(x), q.s0),
-                                        _mm256_and_si256(_mm256_castpd_si256(y), q.s1)),
-                        _mm256_andnot_si256(_mm256_castpd_si256(not_z), q.s2));
-    q.pos = _mm256_add_epi64(q.pos, step);
+    // The stride: z's, y's where y, x's where x (blends select by each lane's mask).
+    const __m256d step =
+        _mm256_blendv_pd(_mm256_blendv_pd(_mm256_castsi256_pd(q.s2), _mm256_castsi256_pd(q.s1), y),
+                         _mm256_castsi256_pd(q.s0), x);
+    q.pos = _mm256_add_epi64(q.pos, _mm256_castpd_si256(step));
     _mm256_store_si256(reinterpret_cast<__m256i*>(word), _mm256_srli_epi64(q.pos, 6));
     _mm256_store_si256(
         reinterpret_cast<__m256i*>(bit),
