@@ -102,6 +102,24 @@ TEST(OctomapAgreement, SeveralSyntheticScansEqualOctomapIncludingClamping) {
     EXPECT_GT(at_lo, 80000u);  // measured 166,138
 }
 
+// One ray from `origin` to `end` (world, metres), `copies` times in one scan, into a map and an
+// OctoMap tree of their own: the voxels that differ; OctoMap's voxels are added to `voxels`.
+size_t RayDifferences(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, size_t copies,
+                      double voxel, size_t& voxels) {
+    IntegrationConfig config;
+    config.max_range_m = kMaxRange;
+    core::Scan scan;
+    scan.T_world_sensor = Eigen::Translation3d(origin) * Eigen::Isometry3d::Identity();
+    scan.points.assign(copies, end - origin);
+    core::VoxelMap map = core::VoxelMap::Create(voxel);
+    octomap::OcTree tree(voxel);
+    Integrator integrator(map, config);
+    InsertBoth(scan, integrator, tree);
+    const testing::MapDifferences d = testing::CompareWithOctomap(map, tree, kLogOddsTol);
+    voxels += d.voxels_theirs;
+    return d.total();
+}
+
 // One ray per map, so that no other ray's voxels hide a wrong one: the walk skips its stopping
 // tests on all but its last steps (TraceRay.hpp), which must leave every voxel where
 // OctoMap's walk puts it. Rays of 1 to about 120 steps from voxel corners or anywhere, ending on
@@ -113,8 +131,6 @@ TEST(OctomapAgreement, SingleRaysEndingOnVoxelCornersEqualOctomap) {
     std::mt19937 rng(19);
     std::uniform_int_distribution<int> near(-6, 6), far(-40, 40), half(0, 1);
     std::uniform_real_distribution<double> anywhere(-1.0, 1.0);
-    IntegrationConfig config;
-    config.max_range_m = kMaxRange;
     size_t differing = 0, voxels = 0;
     for (int i = 0; i < 1500; ++i) {
         const bool on_corner = i % 2 == 0;
@@ -125,23 +141,14 @@ TEST(OctomapAgreement, SingleRaysEndingOnVoxelCornersEqualOctomap) {
         for (int a = 0; a < 3; ++a) {
             end[a] = ((i % 3 == 0 ? far(rng) : near(rng)) + 0.5 * half(rng)) * kVoxel;
         }
-        core::Scan scan;
-        scan.T_world_sensor = Eigen::Translation3d(origin) * Eigen::Isometry3d::Identity();
-        scan.points.assign(static_cast<size_t>(1 + i % 12), end - origin);
-        core::VoxelMap map = core::VoxelMap::Create(kVoxel);
-        octomap::OcTree tree(kVoxel);
-        Integrator integrator(map, config);
-        InsertBoth(scan, integrator, tree);
-        const testing::MapDifferences d = testing::CompareWithOctomap(map, tree, kLogOddsTol);
-        differing += d.total();
-        voxels += d.voxels_theirs;
+        differing += RayDifferences(origin, end, static_cast<size_t>(1 + i % 12), kVoxel, voxels);
     }
     ::testing::Test::RecordProperty("voxels", std::to_string(voxels));
     EXPECT_EQ(differing, 0u);  // 1,426 before the origin was rounded through RoundToFloat
     EXPECT_GT(voxels, 20000u);
 }
 
-// The first `count` scans of a sequence, every `stride`-th, into both maps; `wide`: four rays
+// The first `count` scans of a sequence, every `stride`-th, into both maps; `wide`: several rays
 // at a time where the processor can (IntegrationConfig::wide_walk).
 void ExpectSequenceIdentical(const char* name, double voxel, size_t count, size_t stride,
                              size_t min_voxels, bool wide = true) {
@@ -172,8 +179,6 @@ TEST(OctomapAgreement, DiagonalRaysTieBreakAsOctomap) {
     std::mt19937 rng(23);
     std::uniform_int_distribution<int> cells(-40, 40), axes(0, 3);
     std::uniform_real_distribution<double> anywhere(-1.0, 1.0), part(0.0, 1.0);
-    IntegrationConfig config;
-    config.max_range_m = kMaxRange;
     size_t differing = 0, voxels = 0;
     for (int i = 0; i < 600; ++i) {
         // Which axes tie: x and y, x and z, y and z, or all three.
@@ -187,16 +192,7 @@ TEST(OctomapAgreement, DiagonalRaysTieBreakAsOctomap) {
             origin[a] = tie[tied][a] ? o : anywhere(rng);
             end[a] = tie[tied][a] ? o + run : (cells(rng) + part(rng)) * kVoxel;
         }
-        core::Scan scan;
-        scan.T_world_sensor = Eigen::Translation3d(origin) * Eigen::Isometry3d::Identity();
-        scan.points.assign(static_cast<size_t>(1 + i % 12), end - origin);
-        core::VoxelMap map = core::VoxelMap::Create(kVoxel);
-        octomap::OcTree tree(kVoxel);
-        Integrator integrator(map, config);
-        InsertBoth(scan, integrator, tree);
-        const testing::MapDifferences d = testing::CompareWithOctomap(map, tree, kLogOddsTol);
-        differing += d.total();
-        voxels += d.voxels_theirs;
+        differing += RayDifferences(origin, end, static_cast<size_t>(1 + i % 12), kVoxel, voxels);
     }
     ::testing::Test::RecordProperty("voxels", std::to_string(voxels));
     EXPECT_EQ(differing, 0u);
