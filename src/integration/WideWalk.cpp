@@ -174,6 +174,15 @@ __attribute__((target("avx2"))) void SetUpFour(const RayStarts<float>& starts,
     }
 }
 
+// The set-ups of rays `index[0, n)`: four float rays in lanes, any other one at a time.
+template <typename T>
+void SetUp(const RayStarts<T>& starts, const size_t (&index)[4], int n, RaySetup (&out)[4]) {
+    if constexpr (std::is_same_v<T, float>) {
+        if (n == 4) return SetUpFour(starts, index, out);
+    }
+    for (int k = 0; k < n; ++k) out[k] = starts(index[k]);
+}
+
 // The rest of lane `l`'s ray, alone: its untested steps left, then the tested ones.
 void Finish(const Lanes& lanes, int l, uint64_t box_size, uint64_t* words) {
     const RaySetup& ray = lanes.ray[l];
@@ -202,16 +211,8 @@ void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uin
             for (; next != range.end() && n_ready < 4; ++next) {
                 if (scan.kinds[next] != PointKind::kDropped) index[n_ready++] = next;
             }
-            if constexpr (std::is_same_v<T, float>) {
-                if (n_ready == 4) {
-                    SetUpFour(starts, index, ready);
-                } else {
-                    for (int k = 0; k < n_ready; ++k) ready[k] = starts(index[k]);
-                }
-            } else {
-                for (int k = 0; k < n_ready; ++k) ready[k] = starts(index[k]);
-            }
             if (n_ready == 0) return false;
+            SetUp(starts, index, n_ready, ready);
         }
         ray = ready[taken++];
         return true;
