@@ -1,7 +1,8 @@
 // The district the scale-out work is measured on (docs/simulator.md, "Districts"; docs/bench.md,
 // "District"): `strata simulate` of datasets/scenes/district.json, then `strata integrate` of each
 // session at 0.2 m, each timed and its peak RSS taken from the kernel (wait4), then the map's
-// tiles and size from `strata info --json`. With --scale, then (docs/scale.md, "Measured"): the
+// tiles and size from `strata info --json`, and `strata register` of the last session to the
+// whole map. With --scale, then (docs/scale.md, "Measured"): the
 // first session integrated again by one and by two `mpirun` ranks of one thread each (the same
 // map, compared byte for byte through a PLY export), and the map-reading commands under
 // `--memory-budget 512`, each with its peak RSS. Takes minutes; not run in CI.
@@ -213,6 +214,13 @@ int main(int argc, char** argv) {
         info.at("tile_size_m").get<double>(), Megabytes(work / "map"),
         info.at("tile_bytes").get<double>() / 1e6, info.at("occupied_voxels").get<double>() / 1e6,
         info.at("free_voxels").get<double>() / 1e6, Shell("uptime").c_str());
+    // Step 4: the last session registered to the whole map (read tile by tile, docs/scale.md).
+    const nlohmann::json& last = report.at("sessions").back();
+    const Run reg = Execute({strata, "register", (work / "map").string(), "--kitti",
+                             last.at("dir").get<std::string>(), "--json"},
+                            work / "register.json");
+    std::printf("register %s to the map: %.1f s, peak RSS %.0f MiB\n",
+                last.at("name").get<std::string>().c_str(), reg.seconds, reg.peak_rss_mb);
     if (scale) Scale(strata, work, report.at("sessions").at(0).at("dir").get<std::string>());
     if (!keep) fs::remove_all(work);
     return 0;

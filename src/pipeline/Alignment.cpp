@@ -44,12 +44,12 @@ MapAlignment AlignToMap(const store::MapStore& map, const store::Snapshot& snaps
 
     Eigen::AlignedBox3d box = registration::BoundsOf(cloud.points, guess, options.margin_m);
     MapAlignment a;
-    const core::VoxelMap region = registration::LoadMapRegion(map, snapshot, box);
     if (z_slice) {
         box.min().z() = std::max(box.min().z(), z_slice->first);
         box.max().z() = std::min(box.max().z(), z_slice->second);
     }
-    const std::vector<Eigen::Vector3d> points = registration::OccupiedPoints(region, box);
+    const std::vector<Eigen::Vector3d> points =
+        registration::OccupiedPointsByTiles(map, snapshot, box);
     a.map_points = points.size();
     const registration::Surface surface = registration::Surface::FromPoints(points, config.surface);
     a.surface_ms = MsSince(start);

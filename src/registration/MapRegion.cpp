@@ -2,17 +2,40 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <tuple>
+
 #include "strata/registration/Surface.hpp"
 #include "strata/store/TileReader.hpp"
 
 namespace strata::registration {
 
-core::VoxelMap LoadMapRegion(const store::MapStore& map, const store::Snapshot& snapshot,
-                             const Eigen::AlignedBox3d& box) {
-    // One pass over the region's fused tiles: nothing is kept once they are merged.
+std::vector<Eigen::Vector3d> OccupiedPointsByTiles(const store::MapStore& map,
+                                                   const store::Snapshot& snapshot,
+                                                   const Eigen::AlignedBox3d& box) {
+    // Tile by tile: a tile's grids are dropped once its points are out, so the memory is a
+    // tile per thread and the points.
     const store::TileReader reader(map, snapshot, 0);
-    return reader.LoadFused(
-        reader.Tiles(box.min().head<2>(), box.max().head<2>(), /*halo_voxels=*/0));
+    const std::vector<store::TileKey> keys =
+        reader.Tiles(box.min().head<2>(), box.max().head<2>(), /*halo_voxels=*/0);
+    std::vector<std::vector<Eigen::Vector3d>> per_tile(keys.size());
+    tbb::parallel_for(size_t{0}, keys.size(), [&](size_t i) {
+        if (const auto fused = reader.Fused(keys[i])) per_tile[i] = OccupiedPoints(*fused, box);
+    });
+    size_t total = 0;
+    for (const auto& v : per_tile) total += v.size();
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(total);
+    for (auto& v : per_tile) {
+        points.insert(points.end(), v.begin(), v.end());
+        std::vector<Eigen::Vector3d>().swap(v);
+    }
+    // The surface sums its cells in the order of the points: sorted, the order is the points'
+    // own, whatever tiles the map was cut into.
+    std::sort(points.begin(), points.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+        return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z());
+    });
+    return points;
 }
 
 std::vector<Eigen::Vector3d> SessionPoints(const store::MapStore& map,

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <string>
 
 #include "Catalog.hpp"
 #include "MapStoreImpl.hpp"
@@ -186,7 +188,17 @@ StorageBytes MapStore::Bytes(const Snapshot& current) const {
 core::VoxelMap MapStore::ReadFused(const TileVersion& version) const {
     const std::string bytes =
         detail::ReadVerifiedFile(impl_->dir, version, detail::FileKind::kFused);
-    return detail::DecodeFused(bytes, version.key, impl_->dir / version.file);
+    core::VoxelMap map = detail::DecodeFused(bytes, version.key, impl_->dir / version.file);
+    // A transform read back from a file gives its voxel size within an ulp or two: the settings'
+    // size, the one the tile was written with, keeps every position computed from it exact.
+    const double s = impl_->settings.voxel_size_m;
+    if (!(std::abs(map.voxel_size - s) <= 1e-9 * s)) {
+        throw FormatError((impl_->dir / version.file).string() + ": voxels of " +
+                          std::to_string(map.voxel_size) + " m in a map of " + std::to_string(s) +
+                          " m voxels");
+    }
+    map.voxel_size = s;
+    return map;
 }
 
 SessionLayer MapStore::ReadLayer(const LayerFile& layer) const {
