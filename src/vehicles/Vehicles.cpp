@@ -276,11 +276,18 @@ WindowVehicles ClearVehiclesInWindow(core::VoxelMap& map, const GroundField& gro
     }
     std::vector<Car> cars = FitCars(map, ground, set, whole, origins_map, config);
 
-    // The columns whose edits or counts this window keeps: its core and its own cars'; every car
-    // touching them (in key order, as on the whole map) is cleared and refilled here.
+    // A car belongs to the window whose core holds its own first voxel: every window that sees
+    // its object whole fits the same car, and the owner has the car's surroundings (its ray
+    // range) in its exact ground though the object runs on far beyond the core (a row of cars,
+    // a hedge taken apart). The columns whose edits or counts this window keeps: its core and
+    // its own cars'; every car touching them (in key order, as on the whole map) is cleared and
+    // refilled here.
+    const auto own = [&](const Car& car) {
+        return in_core(*std::min_element(car.object.voxels.begin(), car.object.voxels.end()));
+    };
     std::vector<openvdb::CoordBBox> keep = {window.core};
     for (const Car& car : cars) {
-        if (in_core(car.key.first)) keep.push_back(ColumnsOf(car, map));
+        if (own(car)) keep.push_back(ColumnsOf(car, map));
     }
     const int range = config.ray_check && config.refill
                           ? static_cast<int>(std::ceil(config.ray_range_m / s)) + 1
@@ -313,7 +320,7 @@ WindowVehicles ClearVehiclesInWindow(core::VoxelMap& map, const GroundField& gro
     auto [cleared, refilled] = NewVehicleGrids(map.occupancy->transform());
     ClearAndRefill(map, involved, ground, *set.kept, check.get(), *cleared, *refilled, config);
     for (const Car& car : involved) {
-        if (in_core(car.key.first)) out.vehicles.emplace_back(car.key, car.object.vehicle);
+        if (own(car)) out.vehicles.emplace_back(car.key, car.object.vehicle);
     }
     for (auto it = cleared->cbeginValueOn(); it; ++it) {
         if (in_core(it.getCoord())) {

@@ -1,8 +1,10 @@
 // Each stage of the vehicle pipeline on geometry with a known answer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
@@ -203,6 +205,58 @@ TEST(ClearVehicles, ALabelledCarIsClearedAndItsGroundRefilled) {
     EXPECT_EQ(v.refilled_cells, 44U * 18U);
     EXPECT_TRUE(t.Occupied({0.0, 0.0, 0.02}));
     EXPECT_EQ(r.cleared->activeVoxelCount(), v.cleared_voxels);
+}
+
+// A row of eight touching cars, 35 m long, is one object. Read in two windows, each car belongs
+// to the window whose core holds its own first voxel: the first window sees the whole row but
+// not the last car's ray range, and still answers, with the second window, as the whole map.
+TEST(ClearVehiclesInWindow, ACarFarAlongALongObjectBelongsToTheWindowHoldingIt) {
+    TestMap t;
+    t.Ground(-2.0, 58.0, -6.0, 6.0, 0.0, SemanticClass::kGround);
+    constexpr int kCars = 8;
+    constexpr double kCarM = 4.4;
+    for (int k = 0; k < kCars; ++k) {
+        t.Body(k * kCarM, (k + 1) * kCarM, -0.9, 0.9, 0.3, 1.5, SemanticClass::kVehicle);
+    }
+    std::vector<Eigen::Vector3d> origins;
+    for (double x = 0.0; x <= 40.0; x += 5.0) origins.emplace_back(x, -5.0, 1.7);
+    VehicleConfig config;
+    config.ray_range_m = 2.0;
+    core::VoxelMap whole_map = t.map.DeepCopy();
+    const VehicleResult whole = ClearVehicles(whole_map, origins, config);
+    ASSERT_GE(whole.vehicles.size(), 5U);
+
+    GroundConfig ground_config = config.ground;
+    ground_config.use_labels = true;
+    const GroundField ground = GroundField::FromMap(t.map, ground_config);
+    // Columns in voxels; the row runs over x in [0, 352).
+    const auto columns = [](int x0, int x1) {
+        return openvdb::CoordBBox(openvdb::Coord(x0, -60, 0), openvdb::Coord(x1, 59, 0));
+    };
+    const std::vector<Window> windows = {{columns(-20, 99), columns(-60, 360)},
+                                         {columns(100, 500), columns(-20, 560)}};
+    std::vector<std::pair<CarKey, Vehicle>> cars;
+    std::set<openvdb::Coord> cleared;
+    for (const Window& w : windows) {
+        core::VoxelMap map = t.map.DeepCopy();
+        const WindowVehicles found =
+            ClearVehiclesInWindow(map, ground, origins, w, VehicleSource::kLabel, config);
+        cars.insert(cars.end(), found.vehicles.begin(), found.vehicles.end());
+        for (const auto& [c, key] : found.cleared) cleared.insert(c);
+    }
+    std::sort(cars.begin(), cars.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    ASSERT_EQ(cars.size(), whole.vehicles.size());
+    for (size_t n = 0; n < cars.size(); ++n) {
+        const Vehicle &a = cars[n].second, &b = whole.vehicles[n];
+        EXPECT_EQ(a.footprint.center, b.footprint.center) << n;
+        EXPECT_EQ(a.footprint.yaw_rad, b.footprint.yaw_rad) << n;
+        EXPECT_EQ(a.cleared_voxels, b.cleared_voxels) << n;
+        EXPECT_EQ(a.refilled_cells, b.refilled_cells) << n;
+    }
+    std::set<openvdb::Coord> whole_cleared;
+    for (auto it = whole.cleared->cbeginValueOn(); it; ++it) whole_cleared.insert(it.getCoord());
+    EXPECT_EQ(cleared, whole_cleared);
 }
 
 }  // namespace

@@ -107,7 +107,7 @@ struct Window {
 
 /// @brief What a window contributes to the whole map's ClearVehicles.
 struct WindowVehicles {
-    std::vector<std::pair<CarKey, Vehicle>> vehicles;        ///< objects starting in the core; id 0
+    std::vector<std::pair<CarKey, Vehicle>> vehicles;        ///< first voxel in the core; id 0
     std::vector<std::pair<openvdb::Coord, CarKey>> cleared;  ///< core voxels, by their vehicle
     std::vector<std::pair<openvdb::Coord, float>> refilled;  ///< core cells and their ground z
     size_t candidates = 0;                                   ///< objects starting in the core
@@ -125,7 +125,8 @@ public:
 [[nodiscard]] int WindowHaloVoxels(double voxel_size, const VehicleConfig& config);
 
 /// @brief ClearVehicles on a window of a map (its core and a halo of WindowHaloVoxels): the
-/// vehicles whose objects start in the core and the edits of the core's voxels, those of
+/// vehicles whose own first voxel is in the core (whatever block their object starts in; the
+/// object must lie inside the window) and the edits of the core's voxels, those of
 /// ClearVehicles on the whole map. `map` is edited (read the window's core only afterwards);
 /// `ground` is exact within window.exact; `source` is resolved (not kAuto).
 /// @throw WindowTooSmall when an object near the core reaches out of the window (longer than the
