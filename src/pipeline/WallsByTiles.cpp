@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "TileBudget.hpp"
+#include "WallsGround.hpp"
 #include "WallsKept.hpp"
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
@@ -345,23 +346,29 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     WallsKept kept;
     kept.map = map.EmptyMap();
     // Each rank reads a run of consecutive groups and hands the finished candidates on as it
-    // goes (slants against the map's z axis need nothing of the later groups); what touches
-    // another rank's tiles waits for rank 0, which takes every rank's leftovers at the end.
-    // Levelled to a ground still unknown, everything waits for the end.
-    const bool streamed = !config.level_to_ground;
-    std::optional<walls::WallAssembler> assembler;
-    if (streamed)
-        assembler.emplace(kept.map, config, Eigen::Vector3d::UnitZ(), kept.observed_free.get());
+    // goes; what touches another rank's tiles waits for rank 0, which takes every rank's
+    // leftovers at the end.
     // Not a structured binding: clang (C++17) does not let the lambda below capture one.
     const std::pair<size_t, size_t> run = RunOfRank(split.size(), ranks);
     const size_t begin = run.first, end = run.second;
+    // Slants against the map's z axis need nothing of the later groups; levelled to the ground,
+    // they need the whole map's ground plane, which is sampled first, a tile at a time.
+    walls::GroundPlane ground;
+    if (config.level_to_ground) {
+        std::vector<TileKey> tiles;
+        for (size_t g = begin; g < end; ++g)
+            tiles.insert(tiles.end(), split[g].begin(), split[g].end());
+        ground = GroundByTiles(reader, tiles, config.seed, ranks);
+    }
+    // Optional only to be destroyed before kept.map, which it reads, is moved out.
+    std::optional<walls::WallAssembler> assembler(
+        std::in_place, kept.map, config, walls::UpOf(config, ground), kept.observed_free.get());
     size_t kept_bytes = 0;
     std::chrono::steady_clock::duration handing_on{};  // the later stages' share of the loop
     OnEveryRank(ranks, [&] {
         for (size_t g = begin; g < end; ++g) {
             CollectGroup(reader, settings, split[g], groups, halo, config, kept);
             kept_bytes = std::max(kept_bytes, KeptBytes(kept));
-            if (!streamed) continue;
             const auto t = std::chrono::steady_clock::now();
             HandOn(settings, split[begin].front(), split[g].back(), config, kept, *assembler);
             handing_on += std::chrono::steady_clock::now() - t;
@@ -372,7 +379,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
         // waiting pieces.
         std::string leftovers;
         if (!ranks.root()) {
-            leftovers = EncodeKept(kept, assembler ? assembler->Release() : std::string());
+            leftovers = EncodeKept(kept, assembler->Release());
         }
         const std::vector<std::string> all = ranks.Gather(leftovers);
         if (!ranks.root()) {
@@ -382,8 +389,7 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
             return outcome;
         }
         for (size_t r = 1; r < all.size(); ++r) {
-            const std::string released = MergeKept(all[r], kept);
-            if (assembler) assembler->Absorb(released);
+            assembler->Absorb(MergeKept(all[r], kept));
         }
         kept_bytes = std::max(kept_bytes, KeptBytes(kept));
     }
@@ -399,10 +405,6 @@ WallsOutcome FindWallsByTiles(const store::MapStore& map, const store::Snapshot&
     voted.stats.seconds_columns =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start - handing_on)
             .count();
-    if (!assembler) {
-        assembler.emplace(kept.map, config, walls::UpOf(config, voted.ground),
-                          kept.observed_free.get());
-    }
     assembler->Add(geometry::ConnectedVoxels(std::move(kept.candidates), config.dbscan_eps_voxels));
 
     WallsOutcome outcome;

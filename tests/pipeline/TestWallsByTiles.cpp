@@ -29,11 +29,11 @@ void ExpectSameGrid(const openvdb::GridBase::Ptr& a, const openvdb::GridBase::Pt
     EXPECT_EQ(differ, 0u) << ga->getName();
 }
 
-TEST(WallsByTiles, TileByTileFindsTheWholeMapsWalls) {
+// The walls of the street read whole and in groups of a few tiles, with `config`.
+void ExpectTiledWallsAreWhole(const walls::WallConfig& config) {
     const store::MapStore map =
         store::MapStore::Open(StreetInSmallTiles(), store::MapStore::Access::kRead);
     const store::Snapshot snapshot = map.Latest();
-    const walls::WallConfig config;
     const WallsOutcome whole = FindWalls(map, snapshot, config, 0);
     ASSERT_EQ(whole.tile_groups, 0u);
     ASSERT_GE(whole.result.walls.size(), 3u);
@@ -81,6 +81,16 @@ TEST(WallsByTiles, TileByTileFindsTheWholeMapsWalls) {
             ExpectSameGrid<openvdb::Int32Grid>(gt[i], gw[i]);
         }
     }
+}
+
+TEST(WallsByTiles, TileByTileFindsTheWholeMapsWalls) { ExpectTiledWallsAreWhole({}); }
+
+// Levelled to the ground, the whole map's ground plane is sampled tile by tile first, then the
+// groups stream as without levelling.
+TEST(WallsByTiles, LevelledToTheGroundTileByTileFindsTheWholeMapsWalls) {
+    walls::WallConfig config;
+    config.level_to_ground = true;
+    ExpectTiledWallsAreWhole(config);
 }
 
 TEST(WallsByTiles, ABudgetBelowOneTileAndItsHaloIsRefusedNamingTheFlag) {

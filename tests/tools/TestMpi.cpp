@@ -99,6 +99,14 @@ TEST(MpiCli, WallsOnTwoAndThreeRanksAreTheOneProcessWalls) {
             << r.out;
         EXPECT_EQ(ReadText(csv_n), csv) << ranks << " ranks";
     }
+    // Levelled to the ground: the ranks sample it together and judge against the same plane.
+    const std::string level = "walls " + map.string() + " --no-save --level-to-ground";
+    const Result level_one =
+        Strata(level + " --memory-budget 0 --csv " + (out / "level_one.csv").string());
+    ASSERT_EQ(level_one.code, 0) << level_one.out;
+    const Result level_two = Mpirun(2, level + " --csv " + (out / "level_two.csv").string());
+    ASSERT_EQ(level_two.code, 0) << level_two.out;
+    EXPECT_EQ(ReadText(out / "level_two.csv"), ReadText(out / "level_one.csv"));
     const Result check = Strata("check " + map.string());
     EXPECT_EQ(check.code, 0) << check.out;
     const Result again =
