@@ -47,8 +47,8 @@ TEST(WallsOnRanks, LevelledToTheGroundAreTheOneProcessWalls) {
         for (const auto& grid : map.ReadFused(t).Grids()) memory += grid->memUsage();
         largest = std::max(largest, memory);
     }
-    const WallsOutcome ranked = FindWallsOnRanks(map, snapshot, config, 6 * largest,
-                                                 test::TestRanks());
+    const WallsOutcome ranked =
+        FindWallsOnRanks(map, snapshot, config, 6 * largest, test::TestRanks());
     if (!test::TestRanks().root()) return;  // rank 0 holds the walls
     EXPECT_GT(ranked.tile_groups, 1u);
     EXPECT_EQ(ranked.result.ground.normal, whole.result.ground.normal);
