@@ -2,6 +2,9 @@
 // far outside the basin, a cloud of another place and a corridor are refused.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include "SyntheticGeometry.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/registration/Register.hpp"
@@ -120,6 +123,32 @@ TEST(RegistrationSurface, FitsNormalsOfPlanesAndDropsNothingPlanar) {
     // Every face of the street is axis-aligned, so nearly every normal is (cells on the edges of
     // boxes see two faces and tilt).
     EXPECT_GT(double(axis_aligned) / double(fine.normals.size()), 0.9);
+}
+
+// Each level's index holds its kept cells and nothing else: the cell of each point (its cell's
+// mean) names that point, and the cells dropped as not planar are not there.
+TEST(RegistrationSurface, EachLevelsIndexNamesItsPointsAndNoDroppedCell) {
+    std::vector<Eigen::Vector3d> points = Street(1);
+    // A pole of scattered points: cells that are not planar, dropped.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-0.3, 0.3);
+    for (int k = 0; k < 2000; ++k)
+        points.emplace_back(4.0 + u(rng), 1.0 + u(rng), 1.0 + 3 * u(rng));
+    const Surface s = Surface::FromPoints(points, SurfaceConfig{});
+    for (const SurfaceLevel& level : s.levels) {
+        SCOPED_TRACE("level of " + std::to_string(level.cell_m) + " m");
+        ASSERT_FALSE(level.points.empty());
+        EXPECT_EQ(level.index->activeVoxelCount(), level.points.size());
+        auto acc = level.index->getConstAccessor();
+        for (size_t i = 0; i < level.points.size(); ++i) {
+            const Eigen::Vector3d c =
+                level.points[i] * (1.0 / level.cell_m);  // as the surface bins
+            const openvdb::Coord cell(static_cast<int32_t>(std::floor(c.x())),
+                                      static_cast<int32_t>(std::floor(c.y())),
+                                      static_cast<int32_t>(std::floor(c.z())));
+            ASSERT_EQ(acc.getValue(cell), static_cast<int32_t>(i)) << cell;
+        }
+    }
 }
 
 }  // namespace
