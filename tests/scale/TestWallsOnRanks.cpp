@@ -2,7 +2,11 @@
 // "Walls"): the ranks sample the ground together, so each judges against the whole map's plane.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "MpiTest.hpp"
 #include "StoreTestUtil.hpp"
