@@ -128,7 +128,9 @@ SurfaceLevel BuildLevel(const std::vector<Eigen::Vector3d>& points, double cell_
             level.normals.push_back(normals[i]);
         }
     }
-    openvdb::tools::pruneInactive(cells->tree());
+    // Serial: OpenVDB's compiled prune runs TBB tasks ThreadSanitizer cannot follow (a false
+    // race on the caller's stack, tools/tsan-suppressions.txt), and a leaf check is cheap.
+    openvdb::tools::pruneInactive(cells->tree(), /*threaded=*/false);
     level.index = cells;
     return level;
 }
