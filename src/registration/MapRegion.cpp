@@ -10,6 +10,23 @@
 
 namespace strata::registration {
 
+namespace {
+
+// The tiles' points one after the other, each tile's freed once copied.
+std::vector<Eigen::Vector3d> Concatenated(std::vector<std::vector<Eigen::Vector3d>>& per_tile) {
+    size_t total = 0;
+    for (const auto& v : per_tile) total += v.size();
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(total);
+    for (auto& v : per_tile) {
+        points.insert(points.end(), v.begin(), v.end());
+        std::vector<Eigen::Vector3d>().swap(v);
+    }
+    return points;
+}
+
+}  // namespace
+
 std::vector<Eigen::Vector3d> OccupiedPointsByTiles(const store::MapStore& map,
                                                    const store::Snapshot& snapshot,
                                                    const Eigen::AlignedBox3d& box) {
@@ -22,14 +39,7 @@ std::vector<Eigen::Vector3d> OccupiedPointsByTiles(const store::MapStore& map,
     tbb::parallel_for(size_t{0}, keys.size(), [&](size_t i) {
         if (const auto fused = reader.Fused(keys[i])) per_tile[i] = OccupiedPoints(*fused, box);
     });
-    size_t total = 0;
-    for (const auto& v : per_tile) total += v.size();
-    std::vector<Eigen::Vector3d> points;
-    points.reserve(total);
-    for (auto& v : per_tile) {
-        points.insert(points.end(), v.begin(), v.end());
-        std::vector<Eigen::Vector3d>().swap(v);
-    }
+    std::vector<Eigen::Vector3d> points = Concatenated(per_tile);
     // The surface sums its cells in the order of the points: sorted, the order is the points'
     // own, whatever tiles the map was cut into.
     std::sort(points.begin(), points.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -49,9 +59,7 @@ std::vector<Eigen::Vector3d> SessionPoints(const store::MapStore& map,
         const auto fused = reader.Fused(keys[i]);
         if (layer && fused) per_tile[i] = MaskedPoints(*fused, *layer->occupied);
     });
-    std::vector<Eigen::Vector3d> points;
-    for (const auto& v : per_tile) points.insert(points.end(), v.begin(), v.end());
-    return points;
+    return Concatenated(per_tile);
 }
 
 Eigen::AlignedBox3d BoundsOf(const std::vector<Eigen::Vector3d>& points, const Eigen::Isometry3d& T,
