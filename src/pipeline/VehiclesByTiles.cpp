@@ -1,8 +1,11 @@
-// Vehicles tile by tile. A vehicle is found by the window whose core holds its object's first
-// voxel; windows reach far enough around their core (the longest object, the ray checks' range,
-// the ground's hole filling) that everything the core's vehicles and voxels depend on is what the
-// whole map has there. Only the ground's regions are not local (a street's ground is one region
-// across the map), so a first pass over every tile joins them (vehicles::GroundRegions).
+// Vehicles tile by tile. A vehicle is found by the window whose core holds its own first voxel;
+// windows reach far enough around their core (a vehicle's columns, the ray checks' range, the
+// ground's hole filling) that everything the core's vehicles and voxels depend on is what the
+// whole map has there, but for objects longer than a window is sure to see whole (a hedge, a row
+// of touching cars): their voxels are joined over the windows on rank 0, fitted there, and the
+// blocks their vehicles reach are cleared again with them. The ground's regions are not local
+// either (a street's ground is one region across the map), so a first pass over every tile joins
+// them (vehicles::GroundRegions).
 #include "VehiclesByTiles.hpp"
 
 #include <algorithm>
@@ -44,12 +47,14 @@ bool HasVehicleLabel(const core::VoxelMap& tile) {
     return false;
 }
 
-// Square blocks of `side` x `side` tiles, each read with the tiles within `halo` voxels of it.
+// Square blocks of `side` x `side` tiles, each read with the tiles within `halo` voxels of it;
+// the blocks cover the map's tiles and those within `edits` voxels of them (a vehicle at the
+// map's edge refills ground where no tile was stored yet).
 class Blocks {
 public:
-    Blocks(const store::Snapshot& snapshot, const store::MapSettings& settings, int halo,
+    Blocks(const store::Snapshot& snapshot, const store::MapSettings& settings, int halo, int edits,
            double memory_per_file_byte)
-        : settings_(settings), halo_tiles_(HaloTiles(halo)) {
+        : settings_(settings), halo_tiles_(HaloTiles(halo)), edit_tiles_(HaloTiles(edits)) {
         for (const store::TileVersion& t : snapshot.tiles) {
             bytes_[t.key] = static_cast<uint64_t>(
                 std::ceil(static_cast<double>(t.bytes) * memory_per_file_byte));
@@ -75,11 +80,15 @@ public:
         side_ = side;
         return side;
     }
-    // The blocks holding a tile, by their index.
+    // The blocks holding a tile or a tile the vehicles may edit, by their index.
     [[nodiscard]] std::vector<std::pair<int, int>> Of(int side) const {
         std::set<std::pair<int, int>> blocks;
         for (const auto& [key, bytes] : bytes_) {
-            blocks.insert({FloorDiv(key.x, side), FloorDiv(key.y, side)});
+            for (int dx = -edit_tiles_; dx <= edit_tiles_; ++dx) {
+                for (int dy = -edit_tiles_; dy <= edit_tiles_; ++dy) {
+                    blocks.insert({FloorDiv(key.x + dx, side), FloorDiv(key.y + dy, side)});
+                }
+            }
         }
         return {blocks.begin(), blocks.end()};
     }
@@ -122,6 +131,7 @@ private:
     }
     const store::MapSettings& settings_;
     int halo_tiles_;
+    int edit_tiles_;
     int side_ = 1;
     std::map<TileKey, uint64_t> bytes_;
 };
@@ -190,14 +200,15 @@ vehicles::GroundField WindowGround(const vehicles::GroundRegions& regions,
                                                std::move(clipped), voxel_size, config);
 }
 
-// One window: its tiles read, its ground field, its vehicles; the measured ground columns of
-// its core are counted into `result`.
+// One window: its tiles read, its ground field, its vehicles (the first pass without the long
+// objects' vehicles, the second with them); the first pass counts the measured ground columns of
+// its core into `result`.
 vehicles::WindowVehicles ClearWindow(
     const store::TileReader& reader, const Blocks& blocks, const store::MapSettings& settings,
     const vehicles::GroundRegions& regions, const std::vector<TileKey>& keys,
     const vehicles::Window& bounds, const std::vector<Eigen::Vector3d>& origins,
     vehicles::VehicleResult& result, const vehicles::GroundConfig& ground_config,
-    const vehicles::VehicleConfig& config) {
+    const vehicles::VehicleConfig& config, const vehicles::LongObjects* long_objects) {
     std::vector<TileKey> present;
     CoordBBox columns;
     for (const TileKey& k : keys) {
@@ -208,10 +219,34 @@ vehicles::WindowVehicles ClearWindow(
     size_t measured = 0;
     const vehicles::GroundField ground = WindowGround(
         regions, window, columns, settings.voxel_size_m, ground_config, measured, bounds.core);
-    vehicles::WindowVehicles found =
-        vehicles::ClearVehiclesInWindow(window, ground, origins, bounds, result.source, config);
-    result.ground_columns += measured;
+    vehicles::WindowVehicles found = vehicles::ClearVehiclesInWindow(
+        window, ground, origins, bounds, result.source, config, long_objects);
+    if (long_objects == nullptr) result.ground_columns += measured;
     return found;
+}
+
+// The long objects of every rank's windows joined and fitted on rank 0; every rank gets them.
+vehicles::LongObjects JoinLongObjects(const Ranks& ranks,
+                                      std::vector<vehicles::ObjectSample> samples,
+                                      double voxel_size, vehicles::VehicleSource source,
+                                      const std::vector<Eigen::Vector3d>& origins,
+                                      const vehicles::VehicleConfig& config, size_t& voxels) {
+    if (ranks.size() > 1) {
+        const std::vector<std::string> all = ranks.Gather(EncodeSamples(samples));
+        for (size_t r = 1; r < all.size(); ++r) {
+            std::vector<vehicles::ObjectSample> theirs = DecodeSamples(all[r]);
+            samples.insert(samples.end(), theirs.begin(), theirs.end());
+        }
+    }
+    vehicles::LongObjects long_objects;
+    OnEveryRank(ranks, [&] {
+        if (!ranks.root()) return;
+        voxels = samples.size();
+        long_objects =
+            vehicles::FitLongObjects(std::move(samples), voxel_size, source, origins, config);
+    });
+    if (ranks.size() == 1) return long_objects;
+    return DecodeLongObjects(ranks.Broadcast(ranks.root() ? EncodeLongObjects(long_objects) : ""));
 }
 
 }  // namespace
@@ -240,44 +275,51 @@ VehiclesOutcome ClearVehiclesByTiles(const store::MapStore& map, const store::Sn
     vehicles::GroundConfig ground_config = config.ground;
     ground_config.use_labels = result.source == vehicles::VehicleSource::kLabel;
 
-    Blocks blocks(snapshot, settings, halo, memory_per_file_byte);
+    Blocks blocks(snapshot, settings, halo, vehicles::EditReachVoxels(s, config),
+                  memory_per_file_byte);
     const int side = blocks.Side(memory_budget_bytes, ranks.size(), map.dir().string());
-    const std::vector<std::pair<int, int>> mine = blocks.Of(side);
+    const std::vector<std::pair<int, int>> all_blocks = blocks.Of(side);
+    std::vector<std::pair<int, int>> mine;
+    for (size_t b = static_cast<size_t>(ranks.rank()); b < all_blocks.size();
+         b += static_cast<size_t>(ranks.size())) {
+        mine.push_back(all_blocks[b]);
+    }
     const std::vector<Eigen::Vector3d> origins = SensorOrigins(map, snapshot);
-    const int passes = static_cast<int>(std::ceil(config.ground.fill_radius_m / s));
+    const auto window_of = [&](const std::pair<int, int>& b) {
+        return vehicles::WindowAround(blocks.Core(b), s, config);
+    };
+    // First pass: every block, its long objects' voxels kept and their samples taken.
     std::vector<vehicles::WindowVehicles> found;
+    std::vector<vehicles::ObjectSample> long_samples;
     OnEveryRank(ranks, [&] {
-        for (size_t b = static_cast<size_t>(ranks.rank()); b < mine.size();
-             b += static_cast<size_t>(ranks.size())) {
-            // An object longer than the halo: the window grows (twice the halo, ...) while it
-            // fits the budget.
-            std::string too_small;
-            for (int reach = halo;; reach *= 2) {
-                const std::vector<TileKey> keys_in =
-                    blocks.Window(mine[b], side, blocks.HaloTiles(reach));
-                const uint64_t cost = blocks.Cost(keys_in);
-                if (reach > halo && memory_budget_bytes > 0 && cost > memory_budget_bytes) {
-                    throw RefusedError(
-                        map.dir().string() + ": " + too_small + " (" + std::to_string(reach / 2) +
-                        " voxels of halo); a larger window takes about " +
-                        Megabytes(static_cast<double>(cost)) + ", more than the memory budget of " +
-                        Megabytes(static_cast<double>(memory_budget_bytes)) +
-                        "; raise --memory-budget");
-                }
-                try {
-                    const vehicles::Window bounds{
-                        blocks.Core(mine[b]),
-                        core::GrownXY(blocks.Core(mine[b]), reach - passes - 1)};
-                    found.push_back(ClearWindow(reader, blocks, settings, regions, keys_in, bounds,
-                                                origins, result, ground_config, config));
-                    break;
-                } catch (const vehicles::WindowTooSmall& e) {
-                    too_small = e.what();
-                }
-            }
-            ++outcome.tile_groups;
+        for (const std::pair<int, int>& b : mine) {
+            found.push_back(ClearWindow(reader, blocks, settings, regions, blocks.Window(b, side),
+                                        window_of(b), origins, result, ground_config, config,
+                                        nullptr));
+            std::vector<vehicles::ObjectSample>& samples = found.back().long_samples;
+            long_samples.insert(long_samples.end(), samples.begin(), samples.end());
+            samples = {};
         }
     });
+    outcome.tile_groups = all_blocks.size();
+    // The long objects joined; the blocks their vehicles reach are cleared again with them.
+    const vehicles::LongObjects long_objects = JoinLongObjects(
+        ranks, std::move(long_samples), s, result.source, origins, config, outcome.long_voxels);
+    outcome.long_objects = long_objects.objects;
+    const auto reached = [&](const std::pair<int, int>& b) {
+        return vehicles::LongVehiclesReach(long_objects, window_of(b), s, config);
+    };
+    OnEveryRank(ranks, [&] {
+        for (size_t i = 0; i < mine.size(); ++i) {
+            if (!reached(mine[i])) continue;
+            found[i] = ClearWindow(reader, blocks, settings, regions, blocks.Window(mine[i], side),
+                                   window_of(mine[i]), origins, result, ground_config, config,
+                                   &long_objects);
+        }
+    });
+    outcome.repeated_groups =
+        static_cast<size_t>(std::count_if(all_blocks.begin(), all_blocks.end(), reached));
+    result.candidates += long_objects.objects;
     if (ranks.size() > 1) {
         const std::vector<std::string> all =
             ranks.Gather(ranks.root() ? "" : EncodeWindows(found, result.ground_columns));

@@ -14,8 +14,9 @@ namespace strata::pipeline::detail {
 /// files) stay within `memory_budget_bytes`. The vehicles, their ids and the product grids are
 /// those of the whole map; `cleaned` of the outcome is empty (StoreVehicles edits the tiles one at
 /// a time). On several `ranks` the blocks are shared and rank 0 gets the result.
-/// @throw RefusedError naming --memory-budget when one tile and its halo exceed the budget, or an
-/// object reaches beyond the halo.
+/// Objects longer than a window is sure to see whole are joined on rank 0 and the blocks their
+/// vehicles reach read a second time.
+/// @throw RefusedError naming --memory-budget when one tile and its halo exceed the budget.
 [[nodiscard]] VehiclesOutcome ClearVehiclesByTiles(const store::MapStore& map,
                                                    const store::Snapshot& snapshot,
                                                    const vehicles::VehicleConfig& config,

@@ -1,8 +1,10 @@
 #include "VehiclesExchange.hpp"
 
+#include <cstddef>
 #include <cstdint>
 
 #include "strata/core/Bytes.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::pipeline::detail {
 namespace {
@@ -38,7 +40,89 @@ vehicles::OrientedRect GetRect(const double* in) {
     return r;
 }
 
+struct FlatSample {
+    double xy[2], z_mean, h;
+    int32_t x, y, z, unused;
+};
+struct FlatPart {
+    FlatKey key;
+    int32_t source;
+    double footprint[5], seen[5], base, top, z_min, z_max;
+    uint64_t voxels;  // of the vehicle; its coordinates follow in one list
+};
+
 }  // namespace
+
+std::string EncodeSamples(const std::vector<vehicles::ObjectSample>& samples) {
+    std::vector<FlatSample> flat;
+    flat.reserve(samples.size());
+    for (const vehicles::ObjectSample& s : samples) {
+        FlatSample f{};
+        f.xy[0] = s.xy.x(), f.xy[1] = s.xy.y(), f.z_mean = s.z, f.h = s.h;
+        f.x = s.voxel.x(), f.y = s.voxel.y(), f.z = s.voxel.z();
+        flat.push_back(f);
+    }
+    std::string out;
+    core::PutVector(out, flat);
+    return out;
+}
+
+std::vector<vehicles::ObjectSample> DecodeSamples(const std::string& bytes) {
+    core::ByteReader in(bytes, "vehicles' long objects");
+    std::vector<vehicles::ObjectSample> samples;
+    for (const FlatSample& f : in.GetVector<FlatSample>()) {
+        samples.push_back({Coord(f.x, f.y, f.z), {f.xy[0], f.xy[1]}, f.z_mean, f.h});
+    }
+    return samples;
+}
+
+std::string EncodeLongObjects(const vehicles::LongObjects& long_objects) {
+    std::vector<FlatPart> parts;
+    std::vector<Coord> voxels;
+    for (const vehicles::LongCar& car : long_objects.cars) {
+        const vehicles::FittedPart& p = car.part;
+        const vehicles::Vehicle& v = p.object.vehicle;
+        FlatPart f{};
+        f.key = Flat(car.key);
+        f.source = static_cast<int32_t>(v.source);
+        PutRect(v.footprint, f.footprint);
+        PutRect(v.seen, f.seen);
+        f.base = p.base, f.top = p.top, f.z_min = p.z_min, f.z_max = p.z_max;
+        f.voxels = v.voxels;
+        parts.push_back(f);
+        voxels.insert(voxels.end(), p.object.voxels.begin(), p.object.voxels.end());
+    }
+    std::string out;
+    core::Put(out, static_cast<uint64_t>(long_objects.objects));
+    core::PutVector(out, parts);
+    core::PutVector(out, voxels);
+    return out;
+}
+
+vehicles::LongObjects DecodeLongObjects(const std::string& bytes) {
+    core::ByteReader in(bytes, "vehicles' long objects");
+    vehicles::LongObjects out;
+    out.objects = in.Get<uint64_t>();
+    const std::vector<FlatPart> parts = in.GetVector<FlatPart>();
+    const std::vector<Coord> voxels = in.GetVector<Coord>();
+    size_t next = 0;
+    for (const FlatPart& f : parts) {
+        if (f.voxels > voxels.size() - next) {
+            throw FormatError("vehicles' long objects: more voxels named than sent");
+        }
+        vehicles::FittedPart p;
+        vehicles::Vehicle& v = p.object.vehicle;
+        v.source = static_cast<vehicles::VehicleSource>(f.source);
+        v.footprint = GetRect(f.footprint), v.seen = GetRect(f.seen);
+        v.voxels = f.voxels;
+        p.base = f.base, p.top = f.top, p.z_min = f.z_min, p.z_max = f.z_max;
+        p.object.voxels.assign(voxels.begin() + static_cast<std::ptrdiff_t>(next),
+                               voxels.begin() + static_cast<std::ptrdiff_t>(next + f.voxels));
+        next += f.voxels;
+        out.cars.push_back({Unflat(f.key), std::move(p)});
+    }
+    return out;
+}
 
 std::string EncodeWindows(const std::vector<vehicles::WindowVehicles>& found,
                           size_t ground_columns) {

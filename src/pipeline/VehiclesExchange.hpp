@@ -19,4 +19,14 @@ namespace strata::pipeline::detail {
 [[nodiscard]] vehicles::WindowVehicles DecodeWindows(const std::string& bytes,
                                                      size_t& ground_columns);
 
+/// @brief The long objects' samples of a rank's windows.
+[[nodiscard]] std::string EncodeSamples(const std::vector<vehicles::ObjectSample>& samples);
+/// @throw FormatError when the bytes are cut short.
+[[nodiscard]] std::vector<vehicles::ObjectSample> DecodeSamples(const std::string& bytes);
+
+/// @brief The long objects' vehicles, from rank 0 to every rank.
+[[nodiscard]] std::string EncodeLongObjects(const vehicles::LongObjects& long_objects);
+/// @throw FormatError when the bytes are cut short.
+[[nodiscard]] vehicles::LongObjects DecodeLongObjects(const std::string& bytes);
+
 }  // namespace strata::pipeline::detail

@@ -17,29 +17,11 @@ using core::SemanticClass;
 
 bool IsLabel(int32_t value, SemanticClass c) { return value == static_cast<int32_t>(c); }
 
-// A voxel of an object: where its points lay and how high above the ground.
-struct Sample {
-    Eigen::Vector2d xy;
-    double z = 0.0;
-    double h = 0.0;  // above the ground; NaN when the column has none
-};
-
-std::vector<Sample> Samples(const core::VoxelMap& map, const GroundField& ground,
-                            const std::vector<openvdb::Coord>& voxels) {
-    std::vector<Sample> out;
-    out.reserve(voxels.size());
-    for (const openvdb::Coord& c : voxels) {
-        const Eigen::Vector3d p = map.PointMean(c);
-        out.push_back({p.head<2>(), p.z(), p.z() - ground.Height(c.x(), c.y())});
-    }
-    return out;
-}
-
 // Seen length along the rectangle's axis of the samples in a height band.
-double BandLength(const std::vector<Sample>& samples, const OrientedRect& rect, double lo,
+double BandLength(const std::vector<ObjectSample>& samples, const OrientedRect& rect, double lo,
                   double hi) {
     double min = std::numeric_limits<double>::max(), max = -min;
-    for (const Sample& s : samples) {
+    for (const ObjectSample& s : samples) {
         if (!(s.h >= lo && s.h <= hi)) continue;
         const double t = s.xy.dot(rect.Axis());
         min = std::min(min, t), max = std::max(max, t);
@@ -61,14 +43,14 @@ Eigen::Vector2d NearestOrigin(const std::vector<Eigen::Vector3d>& origins,
 // Columns of a part that rise well above its roof over a small footprint, and their
 // neighbours: what a pillar seen next to a car adds to it (its top is out of the sensor's
 // view from near by, so the structure band cannot catch it).
-std::set<std::pair<int, int>> Towers(const std::vector<openvdb::Coord>& object,
-                                     const std::vector<Sample>& samples,
+std::set<std::pair<int, int>> Towers(const std::vector<ObjectSample>& samples,
                                      const std::vector<size_t>& members,
                                      const VehicleConfig& config) {
     std::map<std::pair<int, int>, double> top;
     for (size_t i : members) {
         if (std::isnan(samples[i].h)) continue;
-        auto [it, added] = top.emplace(std::make_pair(object[i].x(), object[i].y()), samples[i].h);
+        const openvdb::Coord& c = samples[i].voxel;
+        auto [it, added] = top.emplace(std::make_pair(c.x(), c.y()), samples[i].h);
         if (!added) it->second = std::max(it->second, samples[i].h);
     }
     std::set<std::pair<int, int>> towers;
@@ -174,16 +156,25 @@ ObjectSet FindObjects(const core::VoxelMap& map, const GroundField& ground, Vehi
     return set;
 }
 
-std::vector<VehicleObject> FitVehicles(const core::VoxelMap& map, const GroundField& ground,
-                                       const std::vector<openvdb::Coord>& object,
-                                       VehicleSource source,
-                                       const std::vector<Eigen::Vector3d>& origins_map,
-                                       const VehicleConfig& config) {
-    std::vector<VehicleObject> out;
-    if (object.size() < std::max<size_t>(config.min_voxels, 2)) return out;
-    const std::vector<Sample> samples = Samples(map, ground, object);
+std::vector<ObjectSample> SampleObject(const core::VoxelMap& map, const GroundField& ground,
+                                       const std::vector<openvdb::Coord>& object) {
+    std::vector<ObjectSample> out;
+    out.reserve(object.size());
+    for (const openvdb::Coord& c : object) {
+        const Eigen::Vector3d p = map.PointMean(c);
+        out.push_back({c, p.head<2>(), p.z(), p.z() - ground.Height(c.x(), c.y())});
+    }
+    return out;
+}
+
+std::vector<FittedPart> FitParts(const std::vector<ObjectSample>& samples, double voxel_size,
+                                 VehicleSource source,
+                                 const std::vector<Eigen::Vector3d>& origins_map,
+                                 const VehicleConfig& config) {
+    std::vector<FittedPart> out;
+    if (samples.size() < std::max<size_t>(config.min_voxels, 2)) return out;
     std::vector<Eigen::Vector2d> xy;
-    for (const Sample& s : samples) xy.push_back(s.xy);
+    for (const ObjectSample& s : samples) xy.push_back(s.xy);
     const OrientedRect whole = FitLShape(xy, config.heading_step_deg);
 
     // Step 1: touching cars, one object too long or too wide for a car, cut along its axes.
@@ -195,33 +186,37 @@ std::vector<VehicleObject> FitVehicles(const core::VoxelMap& map, const GroundFi
                             : 1;
     const Eigen::Vector2d a = whole.Axis(), b(-a.y(), a.x());
     std::vector<double> along, across;
-    for (const Sample& s : samples) along.push_back(s.xy.dot(a)), across.push_back(s.xy.dot(b));
-    const std::vector<double> cuts_a = Cuts(along, k_length, map.voxel_size);
-    const std::vector<double> cuts_b = Cuts(across, k_width, map.voxel_size);
+    for (const ObjectSample& s : samples) {
+        along.push_back(s.xy.dot(a)), across.push_back(s.xy.dot(b));
+    }
+    const std::vector<double> cuts_a = Cuts(along, k_length, voxel_size);
+    const std::vector<double> cuts_b = Cuts(across, k_width, voxel_size);
     auto slot = [](const std::vector<double>& cuts, double t) {
         return int(std::upper_bound(cuts.begin(), cuts.end(), t) - cuts.begin());
     };
-    std::vector<int> part(object.size(), 0);
-    for (size_t i = 0; i < object.size(); ++i) {
+    std::vector<int> part(samples.size(), 0);
+    for (size_t i = 0; i < samples.size(); ++i) {
         part[i] = slot(cuts_a, along[i]) * k_width + slot(cuts_b, across[i]);
     }
     const int parts = k_length * k_width;
 
     // Step 2: per part, the L-shape, the car it is, and (geometric) whether it looks like one.
     for (int p = 0; p < parts; ++p) {
-        VehicleObject v;
-        std::vector<Sample> mine;
+        FittedPart fitted;
+        VehicleObject& v = fitted.object;
+        std::vector<ObjectSample> mine;
         std::vector<Eigen::Vector2d> mine_xy;
         std::vector<size_t> members;
-        for (size_t i = 0; i < object.size(); ++i) {
+        for (size_t i = 0; i < samples.size(); ++i) {
             if (part[i] == p) members.push_back(i);
         }
         const std::set<std::pair<int, int>> towers = source == VehicleSource::kGeometric
-                                                         ? Towers(object, samples, members, config)
+                                                         ? Towers(samples, members, config)
                                                          : std::set<std::pair<int, int>>{};
         for (size_t i : members) {
-            if (towers.count({object[i].x(), object[i].y()})) continue;
-            v.voxels.push_back(object[i]);
+            const openvdb::Coord& c = samples[i].voxel;
+            if (towers.count({c.x(), c.y()})) continue;
+            v.voxels.push_back(c);
             mine.push_back(samples[i]);
             mine_xy.push_back(samples[i].xy);
         }
@@ -232,19 +227,14 @@ std::vector<VehicleObject> FitVehicles(const core::VoxelMap& map, const GroundFi
         car.seen = FitLShape(mine_xy, config.heading_step_deg);
         car.footprint =
             ExtendToCarSize(car.seen, NearestOrigin(origins_map, car.seen.center), config.car);
-        const openvdb::Coord centre = map.WorldToVoxel(
-            Eigen::Vector3d(car.footprint.center.x(), car.footprint.center.y(), 0.0));
-        double base = std::numeric_limits<double>::max(), top = -base, z_min = base;
-        for (const Sample& s : mine) {
-            z_min = std::min(z_min, s.z);
+        double& base = fitted.base;
+        double& top = fitted.top;
+        base = std::numeric_limits<double>::max(), top = -base;
+        fitted.z_min = base, fitted.z_max = -base;
+        for (const ObjectSample& s : mine) {
+            fitted.z_min = std::min(fitted.z_min, s.z), fitted.z_max = std::max(fitted.z_max, s.z);
             if (std::isnan(s.h)) continue;
             base = std::min(base, s.h), top = std::max(top, s.h);
-        }
-        car.ground_z = ground.Height(centre.x(), centre.y());
-        if (std::isnan(car.ground_z)) car.ground_z = z_min - 0.5 * map.voxel_size;
-        car.height = top > base ? top + 0.5 * map.voxel_size : 0.0;
-        for (const Sample& s : mine) {
-            car.height = std::max(car.height, s.z - car.ground_z + 0.5 * map.voxel_size);
         }
         if (source == VehicleSource::kGeometric) {
             const double band = BandLength(mine, car.seen, 0.3, 1.0);
@@ -256,7 +246,34 @@ std::vector<VehicleObject> FitVehicles(const core::VoxelMap& map, const GroundFi
                                   band >= config.min_low_band_fraction * car.seen.length;
             if (!car_like) continue;
         }
-        out.push_back(std::move(v));
+        out.push_back(std::move(fitted));
+    }
+    return out;
+}
+
+void SetVehicleGround(FittedPart& part, const core::VoxelMap& map, const GroundField& ground) {
+    Vehicle& car = part.object.vehicle;
+    const double s = map.voxel_size;
+    const openvdb::Coord centre =
+        map.WorldToVoxel(Eigen::Vector3d(car.footprint.center.x(), car.footprint.center.y(), 0.0));
+    car.ground_z = ground.Height(centre.x(), centre.y());
+    if (std::isnan(car.ground_z)) car.ground_z = part.z_min - 0.5 * s;
+    car.height = part.top > part.base ? part.top + 0.5 * s : 0.0;
+    // The highest point mean sets the roof as every point mean would (the difference and the
+    // sum are monotonic).
+    car.height = std::max(car.height, part.z_max - car.ground_z + 0.5 * s);
+}
+
+std::vector<VehicleObject> FitVehicles(const core::VoxelMap& map, const GroundField& ground,
+                                       const std::vector<openvdb::Coord>& object,
+                                       VehicleSource source,
+                                       const std::vector<Eigen::Vector3d>& origins_map,
+                                       const VehicleConfig& config) {
+    std::vector<VehicleObject> out;
+    for (FittedPart& part :
+         FitParts(SampleObject(map, ground, object), map.voxel_size, source, origins_map, config)) {
+        SetVehicleGround(part, map, ground);
+        out.push_back(std::move(part.object));
     }
     return out;
 }

@@ -207,10 +207,57 @@ TEST(ClearVehicles, ALabelledCarIsClearedAndItsGroundRefilled) {
     EXPECT_EQ(r.cleared->activeVoxelCount(), v.cleared_voxels);
 }
 
-// A row of eight touching cars, 35 m long, is one object. Read in two windows, each car belongs
-// to the window whose core holds its own first voxel: the first window sees the whole row but
-// not the last car's ray range, and still answers, with the second window, as the whole map.
-TEST(ClearVehiclesInWindow, ACarFarAlongALongObjectBelongsToTheWindowHoldingIt) {
+// What the windows of a map answer together, as the tile-by-tile pipeline drives them: every
+// window once with its long objects kept, the long objects joined from their samples, the
+// windows their vehicles reach again with them; vehicles in key order.
+struct Windowed {
+    std::vector<std::pair<CarKey, Vehicle>> cars;
+    std::set<openvdb::Coord> cleared;
+    size_t candidates = 0, long_objects = 0, repeated = 0;
+};
+Windowed ClearInWindows(const core::VoxelMap& map, const GroundField& ground,
+                        const std::vector<Eigen::Vector3d>& origins,
+                        const std::vector<openvdb::CoordBBox>& cores, VehicleSource source,
+                        const VehicleConfig& config) {
+    std::vector<Window> windows;
+    std::vector<WindowVehicles> found;
+    std::vector<ObjectSample> samples;
+    for (const openvdb::CoordBBox& c : cores) {
+        windows.push_back(WindowAround(c, map.voxel_size, config));
+        core::VoxelMap copy = map.DeepCopy();
+        found.push_back(
+            ClearVehiclesInWindow(copy, ground, origins, windows.back(), source, config));
+        samples.insert(samples.end(), found.back().long_samples.begin(),
+                       found.back().long_samples.end());
+    }
+    const LongObjects long_objects =
+        FitLongObjects(samples, map.voxel_size, source, origins, config);
+    Windowed out;
+    out.long_objects = long_objects.objects;
+    for (size_t w = 0; w < windows.size(); ++w) {
+        if (!LongVehiclesReach(long_objects, windows[w], map.voxel_size, config)) continue;
+        core::VoxelMap copy = map.DeepCopy();
+        found[w] =
+            ClearVehiclesInWindow(copy, ground, origins, windows[w], source, config, &long_objects);
+        ++out.repeated;
+    }
+    for (const WindowVehicles& f : found) {
+        out.cars.insert(out.cars.end(), f.vehicles.begin(), f.vehicles.end());
+        for (const auto& [c, key] : f.cleared) out.cleared.insert(c);
+        out.candidates += f.candidates;
+    }
+    out.candidates += long_objects.objects;
+    std::sort(out.cars.begin(), out.cars.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    return out;
+}
+
+// A row of eight touching cars, 35 m long, is one object, longer than a window with a 20 m ray
+// range is sure to see whole (9.1 m); a lone car beyond it is not. Read in two windows, the row
+// is joined from their samples and its cars are cleared by the windows they reach, each car
+// reported by the window whose core holds its own first voxel: the whole map's cars and cleared
+// voxels.
+TEST(ClearVehiclesInWindow, ARowOfCarsLongerThanAWindowSeesIsJoinedAcrossWindows) {
     TestMap t;
     t.Ground(-2.0, 58.0, -6.0, 6.0, 0.0, SemanticClass::kGround);
     constexpr int kCars = 8;
@@ -218,45 +265,45 @@ TEST(ClearVehiclesInWindow, ACarFarAlongALongObjectBelongsToTheWindowHoldingIt) 
     for (int k = 0; k < kCars; ++k) {
         t.Body(k * kCarM, (k + 1) * kCarM, -0.9, 0.9, 0.3, 1.5, SemanticClass::kVehicle);
     }
+    t.Body(45.0, 49.4, -0.9, 0.9, 0.3, 1.5, SemanticClass::kVehicle);
     std::vector<Eigen::Vector3d> origins;
-    for (double x = 0.0; x <= 40.0; x += 5.0) origins.emplace_back(x, -5.0, 1.7);
+    for (double x = 0.0; x <= 50.0; x += 5.0) origins.emplace_back(x, -5.0, 1.7);
     VehicleConfig config;
-    config.ray_range_m = 2.0;
+    config.ray_range_m = 20.0;
     core::VoxelMap whole_map = t.map.DeepCopy();
     const VehicleResult whole = ClearVehicles(whole_map, origins, config);
-    ASSERT_GE(whole.vehicles.size(), 5U);
+    ASSERT_GE(whole.vehicles.size(), 6U);
+    ASSERT_EQ(whole.candidates, 2U);
 
     GroundConfig ground_config = config.ground;
     ground_config.use_labels = true;
     const GroundField ground = GroundField::FromMap(t.map, ground_config);
-    // Columns in voxels; the row runs over x in [0, 352).
+    // Columns in voxels; the row runs over x in [0, 352), the lone car over [450, 494).
     const auto columns = [](int x0, int x1) {
         return openvdb::CoordBBox(openvdb::Coord(x0, -60, 0), openvdb::Coord(x1, 59, 0));
     };
-    const std::vector<Window> windows = {{columns(-20, 99), columns(-60, 360)},
-                                         {columns(100, 500), columns(-20, 560)}};
-    std::vector<std::pair<CarKey, Vehicle>> cars;
-    std::set<openvdb::Coord> cleared;
-    for (const Window& w : windows) {
-        core::VoxelMap map = t.map.DeepCopy();
-        const WindowVehicles found =
-            ClearVehiclesInWindow(map, ground, origins, w, VehicleSource::kLabel, config);
-        cars.insert(cars.end(), found.vehicles.begin(), found.vehicles.end());
-        for (const auto& [c, key] : found.cleared) cleared.insert(c);
-    }
-    std::sort(cars.begin(), cars.end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
-    ASSERT_EQ(cars.size(), whole.vehicles.size());
-    for (size_t n = 0; n < cars.size(); ++n) {
-        const Vehicle &a = cars[n].second, &b = whole.vehicles[n];
+    const int long_voxels = WindowAround(columns(0, 0), kVoxel, config).long_voxels;
+    ASSERT_LT(long_voxels, 352);
+    ASSERT_GT(long_voxels, 44);
+    const Windowed windowed =
+        ClearInWindows(t.map, ground, origins, {columns(-100, 99), columns(100, 600)},
+                       VehicleSource::kLabel, config);
+    EXPECT_EQ(windowed.long_objects, 1U);
+    EXPECT_EQ(windowed.repeated, 2U);
+    EXPECT_EQ(windowed.candidates, whole.candidates);
+    ASSERT_EQ(windowed.cars.size(), whole.vehicles.size());
+    for (size_t n = 0; n < windowed.cars.size(); ++n) {
+        const Vehicle &a = windowed.cars[n].second, &b = whole.vehicles[n];
         EXPECT_EQ(a.footprint.center, b.footprint.center) << n;
         EXPECT_EQ(a.footprint.yaw_rad, b.footprint.yaw_rad) << n;
+        EXPECT_EQ(a.ground_z, b.ground_z) << n;
+        EXPECT_EQ(a.height, b.height) << n;
         EXPECT_EQ(a.cleared_voxels, b.cleared_voxels) << n;
         EXPECT_EQ(a.refilled_cells, b.refilled_cells) << n;
     }
     std::set<openvdb::Coord> whole_cleared;
     for (auto it = whole.cleared->cbeginValueOn(); it; ++it) whole_cleared.insert(it.getCoord());
-    EXPECT_EQ(cleared, whole_cleared);
+    EXPECT_EQ(windowed.cleared, whole_cleared);
 }
 
 }  // namespace

@@ -58,6 +58,11 @@ void PrintSummary(const pipeline::VehiclesOutcome& outcome, const store::MapStor
         std::cout << "read tile by tile within --memory-budget: " << outcome.tile_groups
                   << " blocks of tiles";
         if (CommandRanks().size() > 1) std::cout << " over " << CommandRanks().size() << " ranks";
+        if (outcome.long_objects > 0) {
+            std::cout << "; " << outcome.long_objects << " objects longer than a block sees whole ("
+                      << outcome.long_voxels << " voxels) joined, " << outcome.repeated_groups
+                      << " blocks read again for their vehicles";
+        }
         std::cout << "\n";
     }
     std::cout << "   id  length m  width m  height m  yaw deg  cleared  refilled  refused   "

@@ -20,7 +20,10 @@ struct VehiclesOutcome {
     vehicles::VehicleResult result;
     vehicles::VehicleConfig config;  ///< as given (StoreVehicles replays the edits with it)
     int64_t commit = 0;              ///< the snapshot's commit
-    size_t tile_groups = 0;          ///< blocks of tiles read one after another; 0: read whole
+    size_t tile_groups = 0;          ///< blocks of tiles read (over all ranks); 0: read whole
+    size_t repeated_groups = 0;      ///< of them, read again for the long objects' vehicles
+    size_t long_objects = 0;         ///< objects longer than a block sees whole, joined on rank 0
+    size_t long_voxels = 0;          ///< their voxels (rank 0 only)
 };
 
 /// @brief Sensor positions of every scan of the snapshot's sessions, in the map frame (the ray
@@ -32,8 +35,8 @@ struct VehiclesOutcome {
 /// tiles fit `memory_budget_bytes` (0: no limit) is loaded whole; a larger one is read tile by
 /// tile (docs/vehicles.md, "Tile by tile") and gives the same vehicles, ids and grids. The map on
 /// disk is not changed.
-/// @throw RefusedError naming --memory-budget when a tile and its halo exceed the budget or an
-/// object is longer than the halo; the store's errors.
+/// @throw RefusedError naming --memory-budget when a tile and its halo exceed the budget; the
+/// store's errors.
 [[nodiscard]] VehiclesOutcome ClearVehicles(const store::MapStore& map,
                                             const store::Snapshot& snapshot,
                                             const vehicles::VehicleConfig& config,
