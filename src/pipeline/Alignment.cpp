@@ -48,14 +48,17 @@ MapAlignment AlignToMap(const store::MapStore& map, const store::Snapshot& snaps
         box.min().z() = std::max(box.min().z(), z_slice->first);
         box.max().z() = std::min(box.max().z(), z_slice->second);
     }
-    const std::vector<Eigen::Vector3d> points =
-        registration::OccupiedPointsByTiles(map, snapshot, box);
-    a.map_points = points.size();
-    const registration::Surface surface = registration::Surface::FromPoints(points, config.surface);
+    // The map's points are dropped once the surface is built: only the surface is matched.
+    const registration::Surface surface = [&] {
+        const std::vector<Eigen::Vector3d> points =
+            registration::OccupiedPointsByTiles(map, snapshot, box);
+        a.map_points = points.size();
+        return registration::Surface::FromPoints(points, config.surface);
+    }();
     a.surface_ms = MsSince(start);
     if (surface.empty()) {
         throw RefusedError("alignment refused: the map has no surface near the guess (" +
-                           std::to_string(points.size()) +
+                           std::to_string(a.map_points) +
                            " occupied voxels in range): check --init");
     }
     a.result = registration::RegisterPoints(surface, cloud.points, guess, config);

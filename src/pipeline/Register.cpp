@@ -27,7 +27,7 @@ SourceCloud ReadSourceCloud(const ScanSource& source, bool as_is, const AlignOpt
         acc.Add(source.Read(i));
         ReportProgress(progress, stage, i + 1, source.size());
     }
-    cloud.points = acc.points();
+    cloud.points = acc.TakePoints();
     return cloud;
 }
 

@@ -40,7 +40,7 @@ std::vector<Eigen::Vector3d> SessionCloud(const std::vector<core::Scan>& scans,
                                           const SessionCloudConfig& config) {
     CloudAccumulator acc(config);
     for (const core::Scan& scan : scans) acc.Add(scan);
-    return acc.points();
+    return acc.TakePoints();
 }
 
 Eigen::AlignedBox3d RangeBox(const Eigen::Isometry3d& T_map_sensor, double range_m) {

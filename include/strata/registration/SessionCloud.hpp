@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <utility>
 #include <vector>
 
 #include "strata/core/GridTypes.hpp"
@@ -27,6 +28,8 @@ public:
     /// @brief Adds `scan.points` moved by `scan.T_world_sensor`; non-finite points are skipped.
     void Add(const core::Scan& scan);
     [[nodiscard]] const std::vector<Eigen::Vector3d>& points() const { return points_; }
+    /// @brief The points, moved out (the accumulator is left without them).
+    [[nodiscard]] std::vector<Eigen::Vector3d> TakePoints() { return std::move(points_); }
 
 private:
     SessionCloudConfig config_;
