@@ -420,6 +420,27 @@ TEST(Store, DamagedTilesAreNamedAndOthersStillRead) {
     EXPECT_EQ(report.problems.size(), 3u);
 }
 
+// A tile whose grids' voxel size is not the map's (a file of another map put in its place, its
+// checksum right) is refused naming the file; a size read back within an ulp is taken as the
+// map's own (TileByTile.RegisterReadsTheWholeMapsPointsTileByTile holds that).
+TEST(Store, ATileOfAnotherVoxelSizeIsRefusedNamingItsFile) {
+    const fs::path dir = Temp("voxel_size"), other_dir = Temp("voxel_size_other");
+    MapStore map = NewMap(dir);
+    (void)Write(map, Session(1, {0, 0, 0}));
+    StoreSettings coarse;
+    coarse.voxel_size_m = 2 * kVoxel;
+    coarse.tile_size_m = kTile;
+    MapStore other = MapStore::Create(other_dir, coarse);
+    (void)Write(other, Session(1, {0, 0, 0}));
+    const TileVersion foreign = other.Latest().tiles.at(0);
+    const fs::path placed = dir / foreign.file;
+    fs::create_directories(placed.parent_path());
+    fs::copy_file(other_dir / foreign.file, placed, fs::copy_options::overwrite_existing);
+    EXPECT_TRUE(ThrowsNaming<FormatError>([&] { (void)map.ReadFused(foreign); }, placed.string()));
+    EXPECT_TRUE(ThrowsNaming<FormatError>([&] { (void)map.ReadFused(foreign); }, "voxels of"));
+    EXPECT_NO_THROW((void)other.ReadFused(foreign));
+}
+
 // A missing or damaged layer file is named by check; reading the fused map does not need it and
 // still works; what needs it (removing that session) fails naming it and changes nothing.
 TEST(Store, DamagedLayerFilesAreNamedAndOnlyWhatNeedsThemFails) {
