@@ -61,6 +61,7 @@ using strata::tools::test::Temp;
 using strata::tools::test::Wait;
 using Clock = std::chrono::steady_clock;
 
+constexpr int kExitBadFormat = 6;   // README, "Exit codes"
 constexpr double kOneTileM = 64.0;  // with --origin 32,32,0 the whole room is in one tile
 // Reader processes and the sessions the writer commits while they read.
 constexpr int kReaders = 3;
@@ -580,11 +581,11 @@ TEST(StoreFaults, DamagedTileFilesAreNamed) {
     fs::resize_file(f.map / truncated.file, kTruncatedBytes);
 
     const Result check = Strata("check " + f.map.string());
-    EXPECT_NE(check.code, 0);
+    EXPECT_EQ(check.code, kExitBadFormat);
     EXPECT_NE(check.out.find(flipped.file), std::string::npos) << check.out;
     EXPECT_NE(check.out.find(truncated.file), std::string::npos) << check.out;
     const Result check_json = Strata("check " + f.map.string() + " --json");
-    EXPECT_NE(check_json.code, 0);
+    EXPECT_EQ(check_json.code, kExitBadFormat);
     const nlohmann::json report = JsonIn(check_json.out);
     std::set<std::string> bad;
     for (const auto& p : report["problems"]) bad.insert(p["file"].get<std::string>());

@@ -6,6 +6,7 @@
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::tools {
 
@@ -34,9 +35,10 @@ void Check(const std::string& dir, bool json) {
                       << "` removes them)\n";
         }
     }
+    // Damaged or missing files, a catalog that fails its check: the map's files are not what
+    // they should be (exit code 6, as a command that stumbles on one of them).
     if (!report.ok()) {
-        throw std::runtime_error(dir + ": " + std::to_string(report.problems.size()) +
-                                 " problems found");
+        throw FormatError(dir + ": " + std::to_string(report.problems.size()) + " problems found");
     }
 }
 
