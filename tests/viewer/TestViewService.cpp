@@ -257,7 +257,7 @@ TEST(ViewService, ADamagedTileFileStopsTheStartWithItsNameAndTheMapUntouched) {
     try {
         (void)Service(map.dir);
         ADD_FAILURE() << "a damaged tile was served";
-    } catch (const std::exception& e) {
+    } catch (const FormatError& e) {
         EXPECT_NE(std::string(e.what()).find(victim.filename().string()), std::string::npos)
             << e.what();
     }
