@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -306,19 +307,28 @@ VehiclesOutcome ClearVehiclesByTiles(const store::MapStore& map, const store::Sn
     const vehicles::LongObjects long_objects = JoinLongObjects(
         ranks, std::move(long_samples), s, result.source, origins, config, outcome.long_voxels);
     outcome.long_objects = long_objects.objects;
+    // Those blocks are dealt out afresh (every rank knows which they are), so that the second
+    // pass shares its work as the first did; a block's first answer is dropped where it is
+    // cleared again.
     const auto reached = [&](const std::pair<int, int>& b) {
         return vehicles::LongVehiclesReach(long_objects, window_of(b), s, config);
     };
+    std::vector<std::pair<int, int>> again;
+    std::copy_if(all_blocks.begin(), all_blocks.end(), std::back_inserter(again), reached);
+    outcome.repeated_groups = again.size();
+    std::vector<vehicles::WindowVehicles> kept;
+    for (size_t i = 0; i < mine.size(); ++i) {
+        if (!reached(mine[i])) kept.push_back(std::move(found[i]));
+    }
+    found = std::move(kept);
     OnEveryRank(ranks, [&] {
-        for (size_t i = 0; i < mine.size(); ++i) {
-            if (!reached(mine[i])) continue;
-            found[i] = ClearWindow(reader, blocks, settings, regions, blocks.Window(mine[i], side),
-                                   window_of(mine[i]), origins, result, ground_config, config,
-                                   &long_objects);
+        for (size_t b = static_cast<size_t>(ranks.rank()); b < again.size();
+             b += static_cast<size_t>(ranks.size())) {
+            found.push_back(ClearWindow(reader, blocks, settings, regions,
+                                        blocks.Window(again[b], side), window_of(again[b]), origins,
+                                        result, ground_config, config, &long_objects));
         }
     });
-    outcome.repeated_groups =
-        static_cast<size_t>(std::count_if(all_blocks.begin(), all_blocks.end(), reached));
     result.candidates += long_objects.objects;
     if (ranks.size() > 1) {
         const std::vector<std::string> all =
