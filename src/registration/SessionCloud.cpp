@@ -1,5 +1,6 @@
 #include "strata/registration/SessionCloud.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "strata/core/Error.hpp"
@@ -11,18 +12,52 @@ void SessionCloudConfig::Validate() const {
     if (!(min_range_m >= 0.0) || !(max_range_m > min_range_m)) {
         throw InvalidArgumentError("session cloud: need 0 <= min_range_m < max_range_m");
     }
+    if (max_points > (size_t{1} << 31)) {
+        throw InvalidArgumentError("session cloud: max_points must be at most 2^31");
+    }
 }
 
-CloudAccumulator::CloudAccumulator(const SessionCloudConfig& config)
-    : config_(config), seen_(openvdb::BoolGrid::create(false)) {
+namespace {
+
+// A well-mixed 64-bit hash of a cell (SplitMix64's finaliser over its packed coordinates).
+uint64_t Mix(uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+uint64_t HashOf(const openvdb::Coord& c) {
+    const auto u = [](int32_t v) { return static_cast<uint64_t>(static_cast<uint32_t>(v)); };
+    return Mix(Mix(Mix(u(c.x())) ^ u(c.y())) ^ u(c.z()));
+}
+
+}  // namespace
+
+CloudAccumulator::CloudAccumulator(const SessionCloudConfig& config) : config_(config) {
     config_.Validate();
+    Reindex();
+}
+
+size_t CloudAccumulator::Find(const openvdb::Coord& cell, uint64_t hash) const {
+    const size_t mask = table_.size() - 1;
+    for (size_t i = static_cast<size_t>(hash) & mask;; i = (i + 1) & mask) {
+        if (table_[i] == 0 || kept_[table_[i] - 1].cell == cell) return i;
+    }
+}
+
+void CloudAccumulator::Reindex() {
+    size_t size = 1024;
+    while (size < 2 * kept_.size() + 2) size *= 2;
+    table_.assign(size, 0);
+    for (size_t k = 0; k < kept_.size(); ++k) {
+        table_[Find(kept_[k].cell, kept_[k].hash)] = static_cast<uint32_t>(k + 1);
+    }
 }
 
 void CloudAccumulator::Add(const core::Scan& scan) {
     const double inv_cell = 1.0 / config_.cell_m;
     const double min2 = config_.min_range_m * config_.min_range_m;
     const double max2 = config_.max_range_m * config_.max_range_m;
-    auto acc = seen_->getAccessor();
     for (const Eigen::Vector3d& p_sensor : scan.points) {
         const double r2 = p_sensor.squaredNorm();
         if (!std::isfinite(r2) || r2 < min2 || r2 > max2) continue;
@@ -30,10 +65,36 @@ void CloudAccumulator::Add(const core::Scan& scan) {
         const openvdb::Coord c(static_cast<int32_t>(std::floor(p.x() * inv_cell)),
                                static_cast<int32_t>(std::floor(p.y() * inv_cell)),
                                static_cast<int32_t>(std::floor(p.z() * inv_cell)));
-        if (acc.isValueOn(c)) continue;
-        acc.setValueOn(c, true);
-        points_.push_back(p);
+        // A cell at or above the bound is out for good (the bound only falls); below it, a
+        // cell kept already keeps its first point.
+        const uint64_t hash = HashOf(c);
+        if (hash >= below_) continue;
+        const size_t at = Find(c, hash);
+        if (table_[at] != 0) continue;
+        kept_.push_back({p, hash, c});
+        table_[at] = static_cast<uint32_t>(kept_.size());
+        if (config_.max_points > 0 && kept_.size() > config_.max_points) {
+            // Past the limit: halve the bound and drop the cells above it, keeping the order.
+            while (kept_.size() > config_.max_points) {
+                below_ /= 2;
+                kept_.erase(std::remove_if(kept_.begin(), kept_.end(),
+                                           [&](const Kept& k) { return k.hash >= below_; }),
+                            kept_.end());
+            }
+            Reindex();
+        } else if (2 * kept_.size() + 2 > table_.size()) {
+            Reindex();
+        }
     }
+}
+
+std::vector<Eigen::Vector3d> CloudAccumulator::TakePoints() {
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(kept_.size());
+    for (const Kept& k : kept_) points.push_back(k.point);
+    std::vector<Kept>().swap(kept_);
+    Reindex();
+    return points;
 }
 
 std::vector<Eigen::Vector3d> SessionCloud(const std::vector<core::Scan>& scans,

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -14,27 +16,45 @@ struct SessionCloudConfig {
     double cell_m = 0.1;        ///< one point per cell (the first), metres
     double min_range_m = 1.0;   ///< the vehicle and the operator are not the map
     double max_range_m = 60.0;  ///< far returns are sparse and noisy
+    /// At most this many points (0 = no limit). A session over more cells keeps the first point
+    /// of each cell whose hash is below a bound, halved until at most `max_points` cells are
+    /// left (about half to all of them): a uniform sample of its cells, the same whatever order the
+    /// scans come in, in about 60 bytes a kept point. The alignment matches at most 20 000 of them
+    /// (RegistrationConfig::max_finest_source_points).
+    size_t max_points = 1'000'000;  ///< at most 2^31
 
     /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
     void Validate() const;
 };
 
 /// @brief The points of many posed scans in their common (session) frame, thinned to one per
-/// cell. Scans are added one at a time, so a long session need not be held in memory.
+/// cell (the first to come) and to at most `max_points` cells, in the order they came. Scans
+/// are added one at a time, so a long session need not be held in memory.
 class CloudAccumulator {
 public:
     /// @throw InvalidArgumentError on an invalid config.
     explicit CloudAccumulator(const SessionCloudConfig& config = {});
     /// @brief Adds `scan.points` moved by `scan.T_world_sensor`; non-finite points are skipped.
     void Add(const core::Scan& scan);
-    [[nodiscard]] const std::vector<Eigen::Vector3d>& points() const { return points_; }
-    /// @brief The points, moved out (the accumulator is left without them).
-    [[nodiscard]] std::vector<Eigen::Vector3d> TakePoints() { return std::move(points_); }
+    [[nodiscard]] size_t size() const { return kept_.size(); }
+    /// @brief The points in the order they came; the accumulator is left empty.
+    [[nodiscard]] std::vector<Eigen::Vector3d> TakePoints();
 
 private:
+    struct Kept {
+        Eigen::Vector3d point;
+        uint64_t hash;  // of its cell
+        openvdb::Coord cell;
+    };
+    // The slot of `cell` in table_: where it is, or the empty slot where it would go.
+    [[nodiscard]] size_t Find(const openvdb::Coord& cell, uint64_t hash) const;
+    // table_ sized for kept_ and filled again.
+    void Reindex();
+
     SessionCloudConfig config_;
-    openvdb::BoolGrid::Ptr seen_;
-    std::vector<Eigen::Vector3d> points_;
+    uint64_t below_ = std::numeric_limits<uint64_t>::max();  // cells kept: hash below this
+    std::vector<Kept> kept_;                                 // in the order they came
+    std::vector<uint32_t> table_;  // open addressing by hash: 1 + index into kept_, 0 = empty
 };
 
 /// @brief CloudAccumulator over all of `scans`.
