@@ -6,6 +6,7 @@
 
 #include "strata/core/Error.hpp"
 #include "strata/registration/MapRegion.hpp"
+#include "strata/registration/MapSurface.hpp"
 
 namespace strata::pipeline {
 
@@ -48,20 +49,18 @@ MapAlignment AlignToMap(const store::MapStore& map, const store::Snapshot& snaps
         box.min().z() = std::max(box.min().z(), z_slice->first);
         box.max().z() = std::min(box.max().z(), z_slice->second);
     }
-    // The map's points are dropped once the surface is built: only the surface is matched.
-    const registration::Surface surface = [&] {
-        const std::vector<Eigen::Vector3d> points =
-            registration::OccupiedPointsByTiles(map, snapshot, box);
-        a.map_points = points.size();
-        return registration::Surface::FromPoints(points, config.surface);
-    }();
-    a.surface_ms = MsSince(start);
-    if (surface.empty()) {
+    // The map's surface is read only around the source, level by level, as the alignment
+    // moves it (registration::MapSurface).
+    registration::MapSurface surface(map, snapshot, box, config.surface);
+    a.result = registration::RegisterPoints(surface, cloud.points, guess, config);
+    a.map_points = surface.points_read();
+    a.surface_reads = surface.reads();
+    a.surface_ms = surface.read_ms();
+    if (!surface.found_surface()) {
         throw RefusedError("alignment refused: the map has no surface near the guess (" +
                            std::to_string(a.map_points) +
                            " occupied voxels in range): check --init");
     }
-    a.result = registration::RegisterPoints(surface, cloud.points, guess, config);
     a.total_ms = MsSince(start);
     return a;
 }
@@ -87,6 +86,7 @@ nlohmann::json AlignmentJson(const MapAlignment& a) {
             {"min_eigenvalue", r.eigenvalues(0)},
             {"map_points", a.map_points},
             {"surface_ms", a.surface_ms},
+            {"surface_reads", a.surface_reads},
             {"total_ms", a.total_ms}};
 }
 

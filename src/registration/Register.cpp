@@ -40,18 +40,17 @@ std::vector<Eigen::Vector3d> Thin(std::vector<Eigen::Vector3d> points, size_t ma
 // Step 1: the source of every level. Thinned once at the finest spacing (range limits applied
 // there), then per level from that much smaller set; capped per level, the finest level with
 // its own (larger) cap: its sampling noise is what is left in the result.
-std::vector<std::vector<Eigen::Vector3d>> SourcePerLevel(const Surface& target,
-                                                         const std::vector<Eigen::Vector3d>& source,
+std::vector<std::vector<Eigen::Vector3d>> SourcePerLevel(const std::vector<Eigen::Vector3d>& source,
                                                          const RegistrationConfig& config) {
-    const auto spacing = [&](const SurfaceLevel& level) {
-        return std::max(config.min_source_spacing_m, level.cell_m * config.source_spacing_ratio);
+    const std::vector<double>& cells = config.surface.level_cells_m;
+    const auto spacing = [&](double cell_m) {
+        return std::max(config.min_source_spacing_m, cell_m * config.source_spacing_ratio);
     };
-    const std::vector<Eigen::Vector3d> finest =
-        Downsample(source, spacing(target.levels.back()), config.min_source_range_m,
-                   config.max_source_range_m);
+    const std::vector<Eigen::Vector3d> finest = Downsample(
+        source, spacing(cells.back()), config.min_source_range_m, config.max_source_range_m);
     std::vector<std::vector<Eigen::Vector3d>> levels;
-    for (size_t l = 0; l + 1 < target.levels.size(); ++l) {
-        levels.push_back(Thin(Downsample(finest, spacing(target.levels[l])),
+    for (size_t l = 0; l + 1 < cells.size(); ++l) {
+        levels.push_back(Thin(Downsample(finest, spacing(cells[l])),
                               static_cast<size_t>(config.max_source_points)));
     }
     levels.push_back(Thin(finest, static_cast<size_t>(config.max_finest_source_points)));
@@ -64,43 +63,45 @@ struct LevelOutcome {
     bool converged = false;
     std::string refusal;
 };
-LevelOutcome AlignLevel(const SurfaceLevel& level, const std::vector<Eigen::Vector3d>& source,
+LevelOutcome AlignLevel(SurfaceLevels& target, size_t l, const std::vector<Eigen::Vector3d>& source,
                         const RegistrationConfig& config, Eigen::Isometry3d& T,
                         RegistrationResult& result, std::ostringstream& brief) {
     const auto start = Clock::now();
+    const double cell_m = config.surface.level_cells_m[l];
     LevelOutcome outcome;
     int it = 0;
     size_t matched = 0;
     while (it < config.max_iterations_per_level && !outcome.converged) {
-        const std::vector<detail::Match> matches = detail::FindMatches(level, source, T);
+        const std::vector<detail::Match> matches =
+            detail::FindMatches(target.Around(l, source, T), source, T);
         matched = matches.size();
         if (matched < static_cast<size_t>(config.min_correspondences)) {
             outcome.refusal = "too few correspondences (" + std::to_string(matched) + ") at the " +
-                              Fixed(level.cell_m, 2) +
+                              Fixed(cell_m, 2) +
                               " m level: the source does not overlap the map near the guess";
             break;
         }
-        const Eigen::Isometry3d delta =
-            detail::SolveIncrement(matches, config.robust_scale_ratio * level.cell_m,
-                                   config.solver_iterations, config.planar);
+        const Eigen::Isometry3d delta = detail::SolveIncrement(
+            matches, config.robust_scale_ratio * cell_m, config.solver_iterations, config.planar);
         T = delta * T;
         ++it;
         outcome.converged = delta.translation().norm() < config.min_step_m &&
                             Eigen::AngleAxisd(delta.linear()).angle() < config.min_step_rad;
     }
     result.iterations += it;
-    brief << "level " << Fixed(level.cell_m, 2) << " m: " << it << " iterations, " << matched << "/"
+    brief << "level " << Fixed(cell_m, 2) << " m: " << it << " iterations, " << matched << "/"
           << source.size() << " matched, " << Fixed(MsSince(start), 1) << " ms\n";
     return outcome;
 }
 
 // Step 3: overlap, residual and degeneracy at the finest level; the first failed check is the
 // refusal (docs/registration.md, step 3).
-std::string FinalChecks(const SurfaceLevel& finest, const std::vector<Eigen::Vector3d>& source,
+std::string FinalChecks(SurfaceLevels& target, const std::vector<Eigen::Vector3d>& source,
                         const RegistrationConfig& config, bool converged,
                         RegistrationResult& result) {
-    const std::vector<detail::Match> matches =
-        detail::FindMatches(finest, source, result.T_map_source);
+    const size_t finest = config.surface.level_cells_m.size() - 1;
+    const std::vector<detail::Match> matches = detail::FindMatches(
+        target.Around(finest, source, result.T_map_source), source, result.T_map_source);
     result.correspondences = matches.size();
     result.overlap = source.empty() ? 0.0 : double(matches.size()) / double(source.size());
     if (matches.size() < static_cast<size_t>(config.min_correspondences)) {
@@ -131,6 +132,23 @@ std::string FinalChecks(const SurfaceLevel& finest, const std::vector<Eigen::Vec
 
 }  // namespace
 
+namespace {
+
+// A Surface's levels, whole.
+class WholeSurface final : public SurfaceLevels {
+public:
+    explicit WholeSurface(const Surface& surface) : surface_(surface) {}
+    const SurfaceLevel& Around(size_t l, const std::vector<Eigen::Vector3d>& /*source*/,
+                               const Eigen::Isometry3d& /*T*/) override {
+        return surface_.levels[l];
+    }
+
+private:
+    const Surface& surface_;
+};
+
+}  // namespace
+
 RegistrationResult RegisterPoints(const Surface& target, const std::vector<Eigen::Vector3d>& source,
                                   const Eigen::Isometry3d& T_map_source_init,
                                   const RegistrationConfig& config) {
@@ -143,23 +161,32 @@ RegistrationResult RegisterPoints(const Surface& target, const std::vector<Eigen
         throw InvalidArgumentError(
             "RegisterPoints: the target surface is empty (no planar map voxels in range)");
     }
+    WholeSurface whole(target);
+    return RegisterPoints(whole, source, T_map_source_init, config);
+}
+
+RegistrationResult RegisterPoints(SurfaceLevels& target, const std::vector<Eigen::Vector3d>& source,
+                                  const Eigen::Isometry3d& T_map_source_init,
+                                  const RegistrationConfig& config) {
+    config.Validate();
     const auto start = Clock::now();
     RegistrationResult result;
     Eigen::Isometry3d T = T_map_source_init;
     std::ostringstream brief;
-    const std::vector<std::vector<Eigen::Vector3d>> sources =
-        SourcePerLevel(target, source, config);
+    const std::vector<std::vector<Eigen::Vector3d>> sources = SourcePerLevel(source, config);
+    target.Prepare(sources, T);
     LevelOutcome last;
-    for (size_t l = 0; l < target.levels.size(); ++l) {
-        if (target.levels[l].points.empty()) continue;  // a coarse level may have no planar cell
-        last = AlignLevel(target.levels[l], sources[l], config, T, result, brief);
+    for (size_t l = 0; l < sources.size(); ++l) {
+        // A coarse level may have no planar cell (near the source).
+        if (target.Around(l, sources[l], T).points.empty()) continue;
+        last = AlignLevel(target, l, sources[l], config, T, result, brief);
         if (!last.refusal.empty()) break;
     }
     result.T_map_source = T;
     result.source_points = sources.back().size();
-    result.refusal = last.refusal.empty() ? FinalChecks(target.levels.back(), sources.back(),
-                                                        config, last.converged, result)
-                                          : last.refusal;
+    result.refusal = last.refusal.empty()
+                         ? FinalChecks(target, sources.back(), config, last.converged, result)
+                         : last.refusal;
     result.converged = result.refusal.empty();
     result.brief_report = brief.str();
     result.time_ms = MsSince(start);

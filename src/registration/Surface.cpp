@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "SurfaceSums.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::registration {
@@ -22,22 +23,12 @@ openvdb::Coord CellOf(const Eigen::Vector3d& p, double inv_cell) {
                           static_cast<int32_t>(std::floor(p.z() * inv_cell)));
 }
 
-// Point count, sum and sum of outer products of the points of a cell: neighbourhoods are sums.
+// Point count, sum and sum of outer products of points relative to some origin (a cell's
+// centre): neighbourhoods are sums.
 struct Moments {
     double n = 0.0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-    void Add(const Eigen::Vector3d& p) {
-        n += 1.0;
-        sum += p;
-        outer += p * p.transpose();
-    }
-    Moments& operator+=(const Moments& o) {
-        n += o.n;
-        sum += o.sum;
-        outer += o.outer;
-        return *this;
-    }
 };
 
 // The normal of the points summed in `m` when they make a plane (smallest eigenvalue small
@@ -52,44 +43,125 @@ bool FitNormal(const Moments& m, const SurfaceConfig& config, Eigen::Vector3d& n
     return true;
 }
 
-SurfaceLevel BuildLevel(const std::vector<Eigen::Vector3d>& points, double cell_m,
-                        const SurfaceConfig& config) {
-    // Step 1: each point's cell, cells numbered as they first come and indexed through a VDB
-    // grid; then their moments, allocated once (a vector of moments grown cell by cell held two
-    // copies of itself at the finest level: 2.5 GB for a district's 14 M points).
-    const double inv_cell = 1.0 / cell_m;
-    auto cells = openvdb::Int32Grid::create(-1);
-    std::vector<openvdb::Coord> coords;
-    std::vector<int32_t> cell_of(points.size());
-    {
-        auto acc = cells->getAccessor();
-        for (size_t k = 0; k < points.size(); ++k) {
-            const openvdb::Coord c = CellOf(points[k], inv_cell);
-            int32_t idx = -1;
-            if (!acc.probeValue(c, idx)) {
-                idx = static_cast<int32_t>(coords.size());
-                acc.setValue(c, idx);
-                coords.push_back(c);
-            }
-            cell_of[k] = idx;
+// A cell's sums in metres, relative to a point `d` away from its centre (d = its centre minus
+// the origin wanted).
+Moments MomentsAt(const detail::CellSums& c, double quantum, const Eigen::Vector3d& d) {
+    const Eigen::Vector3d s =
+        Eigen::Vector3d(double(c.s[0]), double(c.s[1]), double(c.s[2])) * quantum;
+    Eigen::Matrix3d q;
+    q << double(c.q[0]), double(c.q[1]), double(c.q[2]),  //
+        double(c.q[1]), double(c.q[3]), double(c.q[4]),   //
+        double(c.q[2]), double(c.q[4]), double(c.q[5]);
+    const double n = double(c.n);
+    Moments m;
+    m.n = n;
+    m.sum = s + n * d;
+    m.outer =
+        q * (quantum * quantum) + s * d.transpose() + d * s.transpose() + n * d * d.transpose();
+    return m;
+}
+
+// Sums relative to the centre of their cell fit in 2^19 units per axis; squared and summed over
+// at most 2^25 points they stay below 2^63.
+constexpr int kQuantumBits = 20;
+constexpr int64_t kHalfCellUnits = int64_t{1} << (kQuantumBits - 1);
+constexpr int64_t kMaxPointsPerCell = int64_t{1} << 25;
+
+int64_t Units(double metres, double quantum) {
+    const int64_t v = std::llround(metres / quantum);
+    return std::clamp(v, -kHalfCellUnits, kHalfCellUnits - 1);
+}
+
+}  // namespace
+
+namespace detail {
+
+CellSums& CellSums::operator+=(const CellSums& o) {
+    n += o.n;
+    for (size_t k = 0; k < s.size(); ++k) s[k] += o.s[k];
+    for (size_t k = 0; k < q.size(); ++k) q[k] += o.q[k];
+    return *this;
+}
+
+size_t CoordHash::operator()(const openvdb::Coord& c) const {
+    // Large odd multipliers spread neighbouring cells over the buckets.
+    uint64_t h = static_cast<uint64_t>(static_cast<uint32_t>(c.x())) * 0x9E3779B97F4A7C15ULL;
+    h ^= static_cast<uint64_t>(static_cast<uint32_t>(c.y())) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= static_cast<uint64_t>(static_cast<uint32_t>(c.z())) * 0x165667B19E3779F9ULL;
+    return static_cast<size_t>(h ^ (h >> 29));
+}
+
+LevelSums::LevelSums(double cell_m)
+    : cell_m_(cell_m),
+      inv_cell_(1.0 / cell_m),
+      quantum_(cell_m / double(int64_t{1} << kQuantumBits)) {
+    if (!(cell_m > 0.0)) throw InvalidArgumentError("surface: a level's cell must be > 0 m");
+}
+
+openvdb::Coord LevelSums::CellOf(const Eigen::Vector3d& p) const {
+    return registration::CellOf(p, inv_cell_);
+}
+
+void LevelSums::Add(const Eigen::Vector3d& p) {
+    const openvdb::Coord c = CellOf(p);
+    const Eigen::Vector3d rel =
+        p - (Eigen::Vector3d(c.x(), c.y(), c.z()) + Eigen::Vector3d::Constant(0.5)) * cell_m_;
+    const int64_t x = Units(rel.x(), quantum_);
+    const int64_t y = Units(rel.y(), quantum_);
+    const int64_t z = Units(rel.z(), quantum_);
+    CellSums& sums = sums_[c];
+    if (++sums.n > kMaxPointsPerCell) {
+        throw InvalidArgumentError("surface: more than 2^25 points in one cell");
+    }
+    sums.s[0] += x;
+    sums.s[1] += y;
+    sums.s[2] += z;
+    sums.q[0] += x * x;
+    sums.q[1] += x * y;
+    sums.q[2] += x * z;
+    sums.q[3] += y * y;
+    sums.q[4] += y * z;
+    sums.q[5] += z * z;
+}
+
+void LevelSums::Merge(LevelSums&& other) {
+    if (sums_.empty()) {
+        sums_.swap(other.sums_);
+        return;
+    }
+    for (const auto& [cell, sums] : other.sums_) {
+        CellSums& mine = sums_[cell];
+        mine += sums;
+        if (mine.n > kMaxPointsPerCell) {
+            throw InvalidArgumentError("surface: more than 2^25 points in one cell");
         }
     }
-    std::vector<Moments> moments(coords.size());
-    for (size_t k = 0; k < points.size(); ++k) {
-        moments[static_cast<size_t>(cell_of[k])].Add(points[k]);
+    other.sums_ = {};
+}
+
+SurfaceLevel LevelSums::Finish(const SurfaceConfig& config, const openvdb::BoolGrid* fit) const {
+    // Step 1: the cells to fit, in coordinate order.
+    std::vector<openvdb::Coord> cells;
+    cells.reserve(sums_.size());
+    {
+        std::optional<openvdb::BoolGrid::ConstAccessor> in_fit;
+        if (fit) in_fit.emplace(fit->getConstAccessor());
+        for (const auto& entry : sums_) {
+            if (!in_fit || in_fit->isValueOn(entry.first)) cells.push_back(entry.first);
+        }
     }
-    std::vector<int32_t>().swap(cell_of);
-    // Step 2: the normal of each cell from the PCA of its 3 x 3 x 3 neighbourhood; cells that are
-    // not planar (corners, poles, foliage) are dropped.
-    const size_t n = moments.size();
+    std::sort(cells.begin(), cells.end());
+    // Step 2: the normal of each cell: its own points' when they make a plane (sharper at
+    // edges), else that of the 3 x 3 x 3 cells around it; cells that are not planar (corners,
+    // poles, foliage) are dropped. Sums relative to the cell's centre, so the fit does not lose
+    // digits far from the origin.
+    const size_t n = cells.size();
     std::vector<Eigen::Vector3d> normals(n, Eigen::Vector3d::Zero());
     std::vector<uint8_t> keep(n, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
-        auto acc = cells->getConstAccessor();
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            // The cell's own points when they make a plane (sharper at edges), else the
-            // neighbourhood's.
-            Moments m = moments[i];
+            const CellSums& own = sums_.at(cells[i]);
+            Moments m = MomentsAt(own, quantum_, Eigen::Vector3d::Zero());
             if (m.n >= config.min_neighbours && FitNormal(m, config, normals[i])) {
                 keep[i] = 1;
                 continue;
@@ -98,42 +170,42 @@ SurfaceLevel BuildLevel(const std::vector<Eigen::Vector3d>& points, double cell_
             for (int dx = -1; dx <= 1; ++dx) {
                 for (int dy = -1; dy <= 1; ++dy) {
                     for (int dz = -1; dz <= 1; ++dz) {
-                        int32_t j = -1;
-                        if (acc.probeValue(coords[i].offsetBy(dx, dy, dz), j)) {
-                            m += moments[static_cast<size_t>(j)];
-                        }
+                        const auto it = sums_.find(cells[i].offsetBy(dx, dy, dz));
+                        if (it == sums_.end()) continue;
+                        const Moments o =
+                            MomentsAt(it->second, quantum_, Eigen::Vector3d(dx, dy, dz) * cell_m_);
+                        m.n += o.n;
+                        m.sum += o.sum;
+                        m.outer += o.outer;
                     }
                 }
             }
             if (m.n >= config.min_neighbours && FitNormal(m, config, normals[i])) keep[i] = 1;
         }
     });
-    // Step 3: compact to the planar cells, in insertion order (deterministic). The cells' grid
-    // becomes the level's index, the dropped cells switched off, so that two grids of the
-    // level's size never coexist.
+    // Step 3: the planar cells, their means and the index from cell to point.
     SurfaceLevel level;
-    level.cell_m = cell_m;
-    const size_t kept = static_cast<size_t>(std::count(keep.begin(), keep.end(), uint8_t{1}));
-    level.points.reserve(kept);
-    level.normals.reserve(kept);
-    {
-        auto acc = cells->getAccessor();
-        for (size_t i = 0; i < n; ++i) {
-            if (!keep[i]) {
-                acc.setValueOff(coords[i], -1);
-                continue;
-            }
-            acc.setValue(coords[i], static_cast<int32_t>(level.points.size()));
-            level.points.push_back(moments[i].sum / moments[i].n);
-            level.normals.push_back(normals[i]);
-        }
+    level.cell_m = cell_m_;
+    level.index = openvdb::Int32Grid::create(-1);
+    auto acc = level.index->getAccessor();
+    for (size_t i = 0; i < n; ++i) {
+        if (!keep[i]) continue;
+        const CellSums& own = sums_.at(cells[i]);
+        const openvdb::Coord& c = cells[i];
+        const Eigen::Vector3d centre =
+            (Eigen::Vector3d(c.x(), c.y(), c.z()) + Eigen::Vector3d::Constant(0.5)) * cell_m_;
+        acc.setValue(c, static_cast<int32_t>(level.points.size()));
+        level.points.push_back(
+            centre + Eigen::Vector3d(double(own.s[0]), double(own.s[1]), double(own.s[2])) *
+                         (quantum_ / double(own.n)));
+        level.normals.push_back(normals[i]);
     }
-    // Serial: OpenVDB's compiled prune runs TBB tasks ThreadSanitizer cannot follow (a false
-    // race on the caller's stack, tools/tsan-suppressions.txt), and a leaf check is cheap.
-    openvdb::tools::pruneInactive(cells->tree(), /*threaded=*/false);
-    level.index = cells;
     return level;
 }
+
+}  // namespace detail
+
+namespace {
 
 // Active voxels of `tree` with their point means, leaf by leaf in parallel, concatenated in leaf
 // order.
@@ -171,7 +243,11 @@ Surface Surface::FromPoints(const std::vector<Eigen::Vector3d>& points,
     config.Validate();
     Surface surface;
     for (double cell : config.level_cells_m) {
-        surface.levels.push_back(BuildLevel(points, cell, config));
+        detail::LevelSums sums(cell);
+        for (const Eigen::Vector3d& p : points) {
+            if (p.allFinite()) sums.Add(p);
+        }
+        surface.levels.push_back(sums.Finish(config));
     }
     return surface;
 }

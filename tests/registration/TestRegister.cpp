@@ -2,6 +2,7 @@
 // far outside the basin, a cloud of another place and a corridor are refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -123,6 +124,24 @@ TEST(RegistrationSurface, FitsNormalsOfPlanesAndDropsNothingPlanar) {
     // Every face of the street is axis-aligned, so nearly every normal is (cells on the edges of
     // boxes see two faces and tilt).
     EXPECT_GT(double(axis_aligned) / double(fine.normals.size()), 0.9);
+}
+
+// A level's sums are integers: the same surface, bit for bit, whatever the order of its points
+// (the tiles and threads a map is read with), and far from the origin as near it.
+TEST(RegistrationSurface, IsTheSameWhateverTheOrderOfItsPoints) {
+    std::vector<Eigen::Vector3d> points = Street(1);
+    const Eigen::Vector3d far(2345.6, -1234.5, 31.0);
+    for (Eigen::Vector3d& p : points) p += far;
+    const Surface a = Surface::FromPoints(points, SurfaceConfig{});
+    std::mt19937 rng(5);
+    std::shuffle(points.begin(), points.end(), rng);
+    const Surface b = Surface::FromPoints(points, SurfaceConfig{});
+    ASSERT_EQ(a.levels.size(), b.levels.size());
+    for (size_t l = 0; l < a.levels.size(); ++l) {
+        ASSERT_FALSE(a.levels[l].points.empty());
+        EXPECT_TRUE(a.levels[l].points == b.levels[l].points);
+        EXPECT_TRUE(a.levels[l].normals == b.levels[l].normals);
+    }
 }
 
 // Each level's index holds its kept cells and nothing else: the cell of each point (its cell's

@@ -17,6 +17,8 @@
 #include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/Info.hpp"
 #include "strata/registration/MapRegion.hpp"
+#include "strata/registration/MapSurface.hpp"
+#include "strata/registration/Register.hpp"
 #include "strata/registration/Surface.hpp"
 
 namespace strata::pipeline {
@@ -248,6 +250,26 @@ TEST(TileByTile, RegisterReadsTheWholeMapsPointsTileByTile) {
     EXPECT_EQ(a.result.iterations, b.result.iterations);
     EXPECT_EQ(a.map_points, b.map_points);
     EXPECT_TRUE(a.result.T_map_source.matrix() == b.result.T_map_source.matrix());
+
+    // The surface is read only around the source (registration::MapSurface), yet the alignment
+    // is the one against the surface of every point of the box, bit for bit; also when any move
+    // of a point to another cell reads the level again.
+    registration::RegistrationConfig config = options.config;
+    config.min_source_range_m = options.min_range_m;
+    config.max_source_range_m = options.max_range_m;
+    const Eigen::AlignedBox3d near = registration::BoundsOf(cloud.points, guess, options.margin_m);
+    const registration::RegistrationResult w = registration::RegisterPoints(
+        registration::Surface::FromPoints(
+            registration::OccupiedPoints(small.LoadMap(small.Latest()), near), config.surface),
+        cloud.points, guess, config);
+    EXPECT_TRUE(w.T_map_source.matrix() == a.result.T_map_source.matrix());
+    EXPECT_EQ(w.iterations, a.result.iterations);
+    EXPECT_GE(a.surface_reads, config.surface.level_cells_m.size());
+    registration::MapSurface tight(small, small.Latest(), near, config.surface, /*cover_cells=*/0);
+    const registration::RegistrationResult t =
+        registration::RegisterPoints(tight, cloud.points, guess, config);
+    EXPECT_TRUE(t.T_map_source.matrix() == a.result.T_map_source.matrix());
+    EXPECT_GT(tight.reads(), a.surface_reads);
 }
 
 }  // namespace

@@ -43,8 +43,9 @@ struct SourceCloud {
 /// @brief An alignment's result, the size of the map region it used and its times.
 struct MapAlignment {
     registration::RegistrationResult result;
-    size_t map_points = 0;    ///< occupied voxels in the region read
-    double surface_ms = 0.0;  ///< reading the region and building the surface
+    size_t map_points = 0;     ///< occupied voxels in the region read (the most one read took)
+    double surface_ms = 0.0;   ///< reading the map and building the surface, all reads
+    size_t surface_reads = 0;  ///< levels read from the map (registration::MapSurface)
     double total_ms = 0.0;
 };
 
@@ -59,7 +60,7 @@ struct MapAlignment {
 
 /// @brief The report's keys: T (16 numbers, row-major, source frame -> map frame), converged,
 /// rmse_m, overlap, time_ms, refusal, xyz_m, yaw_deg, iterations, correspondences,
-/// source_points, min_eigenvalue, map_points, surface_ms, total_ms.
+/// source_points, min_eigenvalue, map_points, surface_ms, surface_reads, total_ms.
 [[nodiscard]] nlohmann::json AlignmentJson(const MapAlignment& a);
 
 /// @brief Throws RefusedError ("<what> refused: <reason>") when the alignment was not accepted.

@@ -37,6 +37,13 @@ struct RegistrationResult {
                                                 const Eigen::Isometry3d& T_map_source_init,
                                                 const RegistrationConfig& config = {});
 
+/// @brief The same against levels found as the alignment goes (a MapSurface). A level with no
+/// planar cell around the source is skipped; the finest one then refuses the alignment.
+[[nodiscard]] RegistrationResult RegisterPoints(SurfaceLevels& target,
+                                                const std::vector<Eigen::Vector3d>& source,
+                                                const Eigen::Isometry3d& T_map_source_init,
+                                                const RegistrationConfig& config = {});
+
 /// @brief Rigid transform from translation (metres) and yaw about z (degrees).
 [[nodiscard]] Eigen::Isometry3d PoseFromXyzYaw(double x, double y, double z, double yaw_deg);
 /// @brief Yaw (degrees) of a rotation's x axis in the xy plane.

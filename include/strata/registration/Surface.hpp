@@ -33,6 +33,23 @@ struct Surface {
     [[nodiscard]] bool empty() const { return levels.empty() || levels.back().points.empty(); }
 };
 
+/// @brief Where RegisterPoints finds each level of the surface it matches against: a Surface
+/// holds every level whole; a MapSurface (registration/MapSurface.hpp) reads a map's tiles only
+/// around the source, as the alignment moves it.
+class SurfaceLevels {
+public:
+    virtual ~SurfaceLevels() = default;
+    /// @brief Told once, before any level is asked for, the source of every level and the
+    /// first estimate (a MapSurface reads them all in one pass).
+    virtual void Prepare(const std::vector<std::vector<Eigen::Vector3d>>& /*sources*/,
+                         const Eigen::Isometry3d& /*T*/) {}
+    /// @brief Level `l` (SurfaceConfig order), answering for every point of `source` moved by
+    /// `T` as the whole level would. Valid until the next call.
+    [[nodiscard]] virtual const SurfaceLevel& Around(size_t l,
+                                                     const std::vector<Eigen::Vector3d>& source,
+                                                     const Eigen::Isometry3d& T) = 0;
+};
+
 /// @brief Where the endpoints of a map's occupied voxels (log-odds > 0) lay: the `point_mean`
 /// of each voxel, its centre where unknown. Only voxels whose centre is inside `bounds` (map
 /// frame) when given. Parallel over leaves; the order is deterministic.
