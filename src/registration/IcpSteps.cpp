@@ -21,8 +21,7 @@ Eigen::Vector3d Centroid(const std::vector<Match>& matches) {
 // The nearest point of `level` to p within one cell size, or -1. Points lie in their own cell,
 // so the cell of p is searched first and a neighbour only when its box is nearer to p than the
 // best point so far (exact; usually a few of the 27 cells are probed).
-int32_t NearestInLevel(const SurfaceLevel& level, const openvdb::Int32Grid::ConstAccessor& acc,
-                       const Eigen::Vector3d& p) {
+int32_t NearestInLevel(const SurfaceLevel& level, const Eigen::Vector3d& p) {
     const double inv_cell = 1.0 / level.cell_m;
     const Eigen::Vector3d f = (p * inv_cell).array().floor();
     const openvdb::Coord c(static_cast<int32_t>(f.x()), static_cast<int32_t>(f.y()),
@@ -33,8 +32,8 @@ int32_t NearestInLevel(const SurfaceLevel& level, const openvdb::Int32Grid::Cons
     double best = level.cell_m * level.cell_m;
     int32_t best_j = -1;
     const auto Try = [&](const openvdb::Coord& cell) {
-        int32_t j = -1;
-        if (!acc.probeValue(cell, j)) return;
+        const int32_t j = level.index.Find(cell);
+        if (j < 0) return;
         const double d2 = (level.points[static_cast<size_t>(j)] - p).squaredNorm();
         if (d2 < best) {
             best = d2;
@@ -70,10 +69,9 @@ std::vector<Match> FindMatches(const SurfaceLevel& level,
         // Identity
         Matches{},
         [&](const tbb::blocked_range<size_t>& r, Matches found) {
-            auto acc = level.index->getConstAccessor();  // one accessor per task
             for (size_t i = r.begin(); i != r.end(); ++i) {
                 const Eigen::Vector3d p = T * source[i];
-                const int32_t j = NearestInLevel(level, acc, p);
+                const int32_t j = NearestInLevel(level, p);
                 if (j < 0) continue;
                 found.push_back({p, level.points[size_t(j)], level.normals[size_t(j)]});
             }

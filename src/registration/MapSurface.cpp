@@ -18,8 +18,8 @@ namespace {
 
 // The grid grown by `cells` cells along every axis and diagonal (serial: TSan cannot follow
 // OpenVDB's compiled threading, tools/tsan-suppressions.txt).
-openvdb::BoolGrid::Ptr Grown(const openvdb::BoolGrid& grid, int cells) {
-    openvdb::BoolGrid::Ptr out = grid.deepCopy();
+CellMask::Ptr Grown(const CellMask& grid, int cells) {
+    CellMask::Ptr out = grid.deepCopy();
     openvdb::tools::dilateActiveValues(out->tree(), cells, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                        openvdb::tools::IGNORE_TILES, /*threaded=*/false);
     return out;
@@ -70,7 +70,7 @@ void MapSurface::Read(const std::vector<Want>& wants, const Eigen::Isometry3d& T
     // made with (one further: their normals are fitted) and the cells whose points those fits
     // sum (one further again); the x/y extent of the tiles to read.
     struct Reading {
-        openvdb::BoolGrid::Ptr cover, fit, wanted;
+        CellMask::Ptr cover, fit, wanted;
         std::unique_ptr<tbb::enumerable_thread_specific<detail::LevelSums>> parts;
     };
     std::vector<Reading> readings;
@@ -79,7 +79,7 @@ void MapSurface::Read(const std::vector<Want>& wants, const Eigen::Isometry3d& T
         levels_[want.level].reset();
         const double cell = config_.level_cells_m[want.level];
         const detail::LevelSums binning(cell);
-        auto sources = openvdb::BoolGrid::create(false);
+        auto sources = CellMask::create(false);
         {
             auto acc = sources->getAccessor();
             for (const Eigen::Vector3d& p : *want.source) acc.setValueOn(binning.CellOf(T * p));

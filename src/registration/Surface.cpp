@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "SurfaceSums.hpp"
 #include "strata/core/Error.hpp"
@@ -72,7 +73,42 @@ int64_t Units(double metres, double quantum) {
     return std::clamp(v, -kHalfCellUnits, kHalfCellUnits - 1);
 }
 
+// Large odd multipliers spread neighbouring cells over the slots.
+size_t SlotHash(const openvdb::Coord& c) {
+    uint64_t h = static_cast<uint64_t>(static_cast<uint32_t>(c.x())) * 0x9E3779B97F4A7C15ULL;
+    h ^= static_cast<uint64_t>(static_cast<uint32_t>(c.y())) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= static_cast<uint64_t>(static_cast<uint32_t>(c.z())) * 0x165667B19E3779F9ULL;
+    return static_cast<size_t>(h ^ (h >> 29));
+}
+
 }  // namespace
+
+size_t CellTable::SlotOf(const openvdb::Coord& cell) const {
+    const size_t mask = slots_.size() - 1;
+    for (size_t i = SlotHash(cell) & mask;; i = (i + 1) & mask) {
+        if (slots_[i].value < 0 || slots_[i].cell == cell) return i;
+    }
+}
+
+void CellTable::Grow() {
+    std::vector<Slot> old(std::max<size_t>(64, 2 * slots_.size()));
+    old.swap(slots_);
+    for (const Slot& s : old) {
+        if (s.value >= 0) slots_[SlotOf(s.cell)] = s;
+    }
+}
+
+void CellTable::Set(const openvdb::Coord& cell, int32_t value) {
+    if (value < 0) throw InvalidArgumentError("CellTable: values must be >= 0");
+    if (2 * (size_ + 1) > slots_.size()) Grow();
+    Slot& slot = slots_[SlotOf(cell)];
+    if (slot.value < 0) ++size_;
+    slot = {cell, value};
+}
+
+int32_t CellTable::Find(const openvdb::Coord& cell) const {
+    return slots_.empty() ? -1 : slots_[SlotOf(cell)].value;
+}
 
 namespace detail {
 
@@ -81,14 +117,6 @@ CellSums& CellSums::operator+=(const CellSums& o) {
     for (size_t k = 0; k < s.size(); ++k) s[k] += o.s[k];
     for (size_t k = 0; k < q.size(); ++k) q[k] += o.q[k];
     return *this;
-}
-
-size_t CoordHash::operator()(const openvdb::Coord& c) const {
-    // Large odd multipliers spread neighbouring cells over the buckets.
-    uint64_t h = static_cast<uint64_t>(static_cast<uint32_t>(c.x())) * 0x9E3779B97F4A7C15ULL;
-    h ^= static_cast<uint64_t>(static_cast<uint32_t>(c.y())) * 0xC2B2AE3D27D4EB4FULL;
-    h ^= static_cast<uint64_t>(static_cast<uint32_t>(c.z())) * 0x165667B19E3779F9ULL;
-    return static_cast<size_t>(h ^ (h >> 29));
 }
 
 LevelSums::LevelSums(double cell_m)
@@ -102,6 +130,17 @@ openvdb::Coord LevelSums::CellOf(const Eigen::Vector3d& p) const {
     return registration::CellOf(p, inv_cell_);
 }
 
+CellSums& LevelSums::SumsOf(const openvdb::Coord& c) {
+    const int32_t at = at_.Find(c);
+    if (at >= 0) return sums_[static_cast<size_t>(at)];
+    if (sums_.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+        throw InvalidArgumentError("surface: more than 2^31 cells in a level");
+    }
+    at_.Set(c, static_cast<int32_t>(sums_.size()));
+    cells_.push_back(c);
+    return sums_.emplace_back();
+}
+
 void LevelSums::Add(const Eigen::Vector3d& p) {
     const openvdb::Coord c = CellOf(p);
     const Eigen::Vector3d rel =
@@ -109,7 +148,7 @@ void LevelSums::Add(const Eigen::Vector3d& p) {
     const int64_t x = Units(rel.x(), quantum_);
     const int64_t y = Units(rel.y(), quantum_);
     const int64_t z = Units(rel.z(), quantum_);
-    CellSums& sums = sums_[c];
+    CellSums& sums = SumsOf(c);
     if (++sums.n > kMaxPointsPerCell) {
         throw InvalidArgumentError("surface: more than 2^25 points in one cell");
     }
@@ -126,42 +165,46 @@ void LevelSums::Add(const Eigen::Vector3d& p) {
 
 void LevelSums::Merge(LevelSums&& other) {
     if (sums_.empty()) {
-        sums_.swap(other.sums_);
+        std::swap(cells_, other.cells_);
+        std::swap(sums_, other.sums_);
+        std::swap(at_, other.at_);
         return;
     }
-    for (const auto& [cell, sums] : other.sums_) {
-        CellSums& mine = sums_[cell];
-        mine += sums;
+    for (size_t k = 0; k < other.cells_.size(); ++k) {
+        CellSums& mine = SumsOf(other.cells_[k]);
+        mine += other.sums_[k];
         if (mine.n > kMaxPointsPerCell) {
             throw InvalidArgumentError("surface: more than 2^25 points in one cell");
         }
     }
-    other.sums_ = {};
+    other = LevelSums(cell_m_);
 }
 
-SurfaceLevel LevelSums::Finish(const SurfaceConfig& config, const openvdb::BoolGrid* fit) const {
-    // Step 1: the cells to fit, in coordinate order.
-    std::vector<openvdb::Coord> cells;
-    cells.reserve(sums_.size());
+SurfaceLevel LevelSums::Finish(const SurfaceConfig& config, const CellMask* fit) const {
+    // Step 1: the cells to fit (by index into sums_), in coordinate order.
+    std::vector<int32_t> order;
+    order.reserve(cells_.size());
     {
-        std::optional<openvdb::BoolGrid::ConstAccessor> in_fit;
+        std::optional<CellMask::ConstAccessor> in_fit;
         if (fit) in_fit.emplace(fit->getConstAccessor());
-        for (const auto& entry : sums_) {
-            if (!in_fit || in_fit->isValueOn(entry.first)) cells.push_back(entry.first);
+        for (size_t k = 0; k < cells_.size(); ++k) {
+            if (!in_fit || in_fit->isValueOn(cells_[k])) order.push_back(static_cast<int32_t>(k));
         }
     }
-    std::sort(cells.begin(), cells.end());
+    std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
+        return cells_[static_cast<size_t>(a)] < cells_[static_cast<size_t>(b)];
+    });
     // Step 2: the normal of each cell: its own points' when they make a plane (sharper at
     // edges), else that of the 3 x 3 x 3 cells around it; cells that are not planar (corners,
     // poles, foliage) are dropped. Sums relative to the cell's centre, so the fit does not lose
     // digits far from the origin.
-    const size_t n = cells.size();
+    const size_t n = order.size();
     std::vector<Eigen::Vector3d> normals(n, Eigen::Vector3d::Zero());
     std::vector<uint8_t> keep(n, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            const CellSums& own = sums_.at(cells[i]);
-            Moments m = MomentsAt(own, quantum_, Eigen::Vector3d::Zero());
+            const size_t k = static_cast<size_t>(order[i]);
+            Moments m = MomentsAt(sums_[k], quantum_, Eigen::Vector3d::Zero());
             if (m.n >= config.min_neighbours && FitNormal(m, config, normals[i])) {
                 keep[i] = 1;
                 continue;
@@ -170,10 +213,10 @@ SurfaceLevel LevelSums::Finish(const SurfaceConfig& config, const openvdb::BoolG
             for (int dx = -1; dx <= 1; ++dx) {
                 for (int dy = -1; dy <= 1; ++dy) {
                     for (int dz = -1; dz <= 1; ++dz) {
-                        const auto it = sums_.find(cells[i].offsetBy(dx, dy, dz));
-                        if (it == sums_.end()) continue;
-                        const Moments o =
-                            MomentsAt(it->second, quantum_, Eigen::Vector3d(dx, dy, dz) * cell_m_);
+                        const int32_t j = at_.Find(cells_[k].offsetBy(dx, dy, dz));
+                        if (j < 0) continue;
+                        const Moments o = MomentsAt(sums_[static_cast<size_t>(j)], quantum_,
+                                                    Eigen::Vector3d(dx, dy, dz) * cell_m_);
                         m.n += o.n;
                         m.sum += o.sum;
                         m.outer += o.outer;
@@ -186,15 +229,14 @@ SurfaceLevel LevelSums::Finish(const SurfaceConfig& config, const openvdb::BoolG
     // Step 3: the planar cells, their means and the index from cell to point.
     SurfaceLevel level;
     level.cell_m = cell_m_;
-    level.index = openvdb::Int32Grid::create(-1);
-    auto acc = level.index->getAccessor();
     for (size_t i = 0; i < n; ++i) {
         if (!keep[i]) continue;
-        const CellSums& own = sums_.at(cells[i]);
-        const openvdb::Coord& c = cells[i];
+        const size_t k = static_cast<size_t>(order[i]);
+        const CellSums& own = sums_[k];
+        const openvdb::Coord& c = cells_[k];
         const Eigen::Vector3d centre =
             (Eigen::Vector3d(c.x(), c.y(), c.z()) + Eigen::Vector3d::Constant(0.5)) * cell_m_;
-        acc.setValue(c, static_cast<int32_t>(level.points.size()));
+        level.index.Set(c, static_cast<int32_t>(level.points.size()));
         level.points.push_back(
             centre + Eigen::Vector3d(double(own.s[0]), double(own.s[1]), double(own.s[2])) *
                          (quantum_ / double(own.n)));
@@ -270,16 +312,16 @@ std::vector<Eigen::Vector3d> Downsample(const std::vector<Eigen::Vector3d>& poin
     const double inv_cell = 1.0 / cell_m;
     const double min_range2 = min_range_m * min_range_m;
     const double max_range2 = max_range_m * max_range_m;
-    openvdb::BoolGrid::Ptr seen = openvdb::BoolGrid::create(false);
-    auto acc = seen->getAccessor();
+    // A table, not a grid: a sample thinned over a district leaves a point or two per leaf.
+    CellTable seen;
     std::vector<Eigen::Vector3d> out;
     for (const Eigen::Vector3d& p : points) {
         if (!p.allFinite()) continue;
         const double r2 = p.squaredNorm();
         if (r2 < min_range2 || (max_range_m > 0.0 && r2 > max_range2)) continue;
         const openvdb::Coord c = CellOf(p, inv_cell);
-        if (acc.isValueOn(c)) continue;
-        acc.setValueOn(c, true);
+        if (seen.Contains(c)) continue;
+        seen.Set(c, 0);
         out.push_back(p);
     }
     return out;

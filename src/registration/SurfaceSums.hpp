@@ -6,7 +6,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
-#include <unordered_map>
+#include <vector>
 
 #include "strata/registration/RegistrationConfig.hpp"
 #include "strata/registration/Surface.hpp"
@@ -21,10 +21,6 @@ struct CellSums {
     std::array<int64_t, 3> s{};
     std::array<int64_t, 6> q{};  ///< xx, xy, xz, yy, yz, zz
     CellSums& operator+=(const CellSums& o);
-};
-
-struct CoordHash {
-    size_t operator()(const openvdb::Coord& c) const;
 };
 
 /// The cell sums of one level.
@@ -47,13 +43,17 @@ public:
     /// points and, when its own points or those of the 27 cells around it make a plane, its
     /// normal; cells without a plane are dropped. Cells in coordinate order (deterministic).
     [[nodiscard]] SurfaceLevel Finish(const SurfaceConfig& config,
-                                      const openvdb::BoolGrid* fit = nullptr) const;
+                                      const CellMask* fit = nullptr) const;
 
 private:
     double cell_m_;
     double inv_cell_;
-    double quantum_;  // metres per unit of the sums
-    std::unordered_map<openvdb::Coord, CellSums, CoordHash> sums_;
+    double quantum_;                            // metres per unit of the sums
+    CellSums& SumsOf(const openvdb::Coord& c);  // inserted when new
+
+    std::vector<openvdb::Coord> cells_;  // in the order they came
+    std::vector<CellSums> sums_;         // of cells_[k]
+    CellTable at_;                       // cell -> k
 };
 
 }  // namespace strata::registration::detail

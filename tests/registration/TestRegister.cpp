@@ -157,15 +157,14 @@ TEST(RegistrationSurface, EachLevelsIndexNamesItsPointsAndNoDroppedCell) {
     for (const SurfaceLevel& level : s.levels) {
         SCOPED_TRACE("level of " + std::to_string(level.cell_m) + " m");
         ASSERT_FALSE(level.points.empty());
-        EXPECT_EQ(level.index->activeVoxelCount(), level.points.size());
-        auto acc = level.index->getConstAccessor();
+        EXPECT_EQ(level.index.size(), level.points.size());
         for (size_t i = 0; i < level.points.size(); ++i) {
             const Eigen::Vector3d c =
                 level.points[i] * (1.0 / level.cell_m);  // as the surface bins
             const openvdb::Coord cell(static_cast<int32_t>(std::floor(c.x())),
                                       static_cast<int32_t>(std::floor(c.y())),
                                       static_cast<int32_t>(std::floor(c.z())));
-            ASSERT_EQ(acc.getValue(cell), static_cast<int32_t>(i)) << cell;
+            ASSERT_EQ(level.index.Find(cell), static_cast<int32_t>(i)) << cell;
         }
     }
 }

@@ -46,7 +46,7 @@ public:
 private:
     struct Level {
         SurfaceLevel level;
-        openvdb::BoolGrid::Ptr cover;  // the cells a query may fall in
+        CellMask::Ptr cover;  // the cells a query may fall in
     };
     struct Want {
         size_t level;
