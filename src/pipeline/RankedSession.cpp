@@ -158,10 +158,11 @@ void AddStats(store::WriterStats& sum, const store::WriterStats& s) {
 }  // namespace
 
 int TileOwner(const store::TileKey& key, int ranks) {
-    // Odd multipliers mix both coordinates; the unsigned arithmetic wraps, never overflows.
-    const uint64_t h = static_cast<uint64_t>(static_cast<uint32_t>(key.x)) * 0x9E3779B97F4A7C15ull ^
-                       static_cast<uint64_t>(static_cast<uint32_t>(key.y)) * 0xC2B2AE3D27D4EB4Full;
-    return static_cast<int>((h >> 32) % static_cast<uint64_t>(std::max(1, ranks)));
+    // Diagonals: along a row or a column of tiles the owners cycle through every rank, so the
+    // tiles in a scan's range are shared out evenly in every round, not only over the map.
+    const int64_t n = std::max(1, ranks);
+    const int64_t d = (int64_t{key.x} + int64_t{key.y}) % n;
+    return static_cast<int>(d < 0 ? d + n : d);
 }
 
 void OnEveryRank(const Ranks& ranks, const std::function<void()>& step) {

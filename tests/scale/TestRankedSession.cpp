@@ -148,6 +148,16 @@ TEST(RankedSession, TileOwnersSpreadNeighbouringTiles) {
             for (int y = -8; y < 8; ++y) ++counts[static_cast<size_t>(TileOwner({x, y}, n))];
         }
         for (int c : counts) EXPECT_NEAR(c, 256.0 / n, 256.0 / n * 0.25) << n;
+        // Along a row and along a column, any n tiles in a row are n ranks.
+        for (int k = -8; k + n <= 8; ++k) {
+            std::set<int> row, column;
+            for (int j = 0; j < n; ++j) {
+                row.insert(TileOwner({k + j, 3}, n));
+                column.insert(TileOwner({-5, k + j}, n));
+            }
+            EXPECT_EQ(row.size(), static_cast<size_t>(n));
+            EXPECT_EQ(column.size(), static_cast<size_t>(n));
+        }
     }
     EXPECT_EQ(TileOwner({5, -7}, 1), 0);
 }

@@ -14,8 +14,9 @@
 
 namespace strata::pipeline {
 
-/// @brief The rank that keeps tile `key` among `ranks` ranks: a hash of the key, so that
-/// neighbouring tiles (a street's) spread over the ranks.
+/// @brief The rank that keeps tile `key` among `ranks` ranks: (x + y) mod ranks, diagonals, so
+/// that the tiles along a row or a column (a street's, a scan's neighbourhood) cycle through
+/// every rank.
 [[nodiscard]] int TileOwner(const store::TileKey& key, int ranks);
 
 /// @brief What a ranked session wrote, summed over ranks.

@@ -14,7 +14,8 @@ namespace strata::registration {
 /// around the source: each level holds the cells within `cover_cells` cells of the source's
 /// points (moved by the estimate it was built at), fitted from the cells two further out, and is
 /// read again when the alignment moves a point out of them. A level answers exactly as
-/// Surface::FromPoints of all the box's points would (RegistrationMapSurface tests), while the
+/// Surface::FromPoints of all the box's points would
+/// (TileByTile.RegisterReadsTheWholeMapsPointsTileByTile), while the
 /// memory follows the source's sampled points, not the map or the session.
 /// @note Holds a reference to `map` (and a copy of `snapshot`). Errors of the store propagate.
 class MapSurface final : public SurfaceLevels {
@@ -26,7 +27,8 @@ public:
     MapSurface(const store::MapStore& map, const store::Snapshot& snapshot,
                const Eigen::AlignedBox3d& box, const SurfaceConfig& config, int cover_cells = 1);
 
-    /// @brief Reads every level not read yet around its source, in one pass over the tiles.
+    /// @brief Reads the coarse levels (all but the finest) around their sources, in one pass
+    /// over the tiles; the finest is read when the alignment first asks for it.
     void Prepare(const std::vector<std::vector<Eigen::Vector3d>>& sources,
                  const Eigen::Isometry3d& T) override;
     /// @brief Level `l`, read again when a point of `source` moved by `T` left its cover; the
