@@ -35,23 +35,6 @@ uint64_t HashOf(const openvdb::Coord& c) {
 
 CloudAccumulator::CloudAccumulator(const SessionCloudConfig& config) : config_(config) {
     config_.Validate();
-    Reindex();
-}
-
-size_t CloudAccumulator::Find(const openvdb::Coord& cell, uint64_t hash) const {
-    const size_t mask = table_.size() - 1;
-    for (size_t i = static_cast<size_t>(hash) & mask;; i = (i + 1) & mask) {
-        if (table_[i] == 0 || kept_[table_[i] - 1].cell == cell) return i;
-    }
-}
-
-void CloudAccumulator::Reindex() {
-    size_t size = 1024;
-    while (size < 2 * kept_.size() + 2) size *= 2;
-    table_.assign(size, 0);
-    for (size_t k = 0; k < kept_.size(); ++k) {
-        table_[Find(kept_[k].cell, kept_[k].hash)] = static_cast<uint32_t>(k + 1);
-    }
 }
 
 void CloudAccumulator::Add(const core::Scan& scan) {
@@ -69,10 +52,9 @@ void CloudAccumulator::Add(const core::Scan& scan) {
         // cell kept already keeps its first point.
         const uint64_t hash = HashOf(c);
         if (hash >= below_) continue;
-        const size_t at = Find(c, hash);
-        if (table_[at] != 0) continue;
+        if (index_.Contains(c)) continue;
+        index_.Set(c, static_cast<int32_t>(kept_.size()));
         kept_.push_back({p, hash, c});
-        table_[at] = static_cast<uint32_t>(kept_.size());
         if (config_.max_points > 0 && kept_.size() > config_.max_points) {
             // Past the limit: halve the bound and drop the cells above it, keeping the order.
             while (kept_.size() > config_.max_points) {
@@ -81,9 +63,10 @@ void CloudAccumulator::Add(const core::Scan& scan) {
                                            [&](const Kept& k) { return k.hash >= below_; }),
                             kept_.end());
             }
-            Reindex();
-        } else if (2 * kept_.size() + 2 > table_.size()) {
-            Reindex();
+            index_ = {};
+            for (size_t k = 0; k < kept_.size(); ++k) {
+                index_.Set(kept_[k].cell, static_cast<int32_t>(k));
+            }
         }
     }
 }
@@ -93,7 +76,7 @@ std::vector<Eigen::Vector3d> CloudAccumulator::TakePoints() {
     points.reserve(kept_.size());
     for (const Kept& k : kept_) points.push_back(k.point);
     std::vector<Kept>().swap(kept_);
-    Reindex();
+    index_ = {};
     return points;
 }
 

@@ -8,6 +8,7 @@
 
 #include "strata/core/GridTypes.hpp"
 #include "strata/core/Scan.hpp"
+#include "strata/registration/Surface.hpp"
 
 namespace strata::registration {
 
@@ -46,15 +47,10 @@ private:
         uint64_t hash;  // of its cell
         openvdb::Coord cell;
     };
-    // The slot of `cell` in table_: where it is, or the empty slot where it would go.
-    [[nodiscard]] size_t Find(const openvdb::Coord& cell, uint64_t hash) const;
-    // table_ sized for kept_ and filled again.
-    void Reindex();
-
     SessionCloudConfig config_;
     uint64_t below_ = std::numeric_limits<uint64_t>::max();  // cells kept: hash below this
     std::vector<Kept> kept_;                                 // in the order they came
-    std::vector<uint32_t> table_;  // open addressing by hash: 1 + index into kept_, 0 = empty
+    CellTable index_;                                        // kept cell -> its index in kept_
 };
 
 /// @brief CloudAccumulator over all of `scans`.
