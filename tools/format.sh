@@ -24,10 +24,10 @@ if ((!check)); then
   clang-format -i "${files[@]}"
   exit 0
 fi
-differ=()
-for f in "${files[@]}"; do
-  clang-format --dry-run --Werror "$f" >/dev/null 2>&1 || differ+=("$f")
-done
+# One clang-format per file (its exit code names the file), as many at a time as there are cores:
+# 486 files took 45 s one after the other on a 2-core AMD EPYC (docs/reliability.md).
+mapfile -t differ < <(printf '%s\0' "${files[@]}" | xargs -0 -r -n 8 -P "$(nproc)" sh -c \
+  'for f; do clang-format --dry-run --Werror "$f" >/dev/null 2>&1 || echo "$f"; done' sh | sort)
 if ((${#differ[@]})); then
   echo "format.sh: ${#differ[@]} of ${#files[@]} files are not formatted (tools/format.sh fixes them):"
   printf '  %s\n' "${differ[@]}"

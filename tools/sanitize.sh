@@ -16,6 +16,8 @@
 #   STRATA_SANITIZE_MIN_TESTS=N  fail when fewer than N tests are selected (.ci/run sets it;
 #          default: $tsan_min_tests for tsan without arguments, else 1). With no test selected
 #          ctest itself fails (--no-tests=error).
+#   STRATA_SANITIZE_BUILD_ONLY=1  build (and for tsan, libtbb) and stop: .ci/run builds both
+#          in the background while the normal build's tests run, then runs the tests here.
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
 # Tests read STRATA_SANITIZER (address or thread, set here) to shrink what is too slow there.
 set -euo pipefail
@@ -123,6 +125,7 @@ else
   export STRATA_SANITIZER=thread
 fi
 echo "sanitize.sh: $mode build took $(($(date +%s) - start)) s"
+[[ ${STRATA_SANITIZE_BUILD_ONLY:-} == 1 ]] && exit 0
 
 reports="$build/sanitizer-reports"
 rm -rf "$reports"
