@@ -71,7 +71,8 @@ py::dict QueryBox(const core::VoxelMap& map, const py::object& lo, const py::obj
         const auto labels = map.label->getConstAccessor();
         const auto weights = map.label_weight->getConstAccessor();
         core::EndpointReader counts(map);
-        // Active voxels only, never the dense box (STYLE.md E); a tile is expanded to voxels.
+        // Active voxels only, never the dense box (docs/architecture.md, "Code style"); a tile
+        // is expanded to voxels.
         for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
             openvdb::CoordBBox part = it.getBoundingBox();
             if (!part.hasOverlap(box)) continue;

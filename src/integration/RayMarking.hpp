@@ -1,6 +1,6 @@
 #pragma once
-// Private to the integrator: which voxels one scan saw free and occupied (ARCHITECTURE.md,
-// "Integration semantics"), marked into per-thread bitmaps over the scan's bounding box.
+// Private to the integrator: which voxels one scan saw free and occupied (docs/integration.md,
+// "Semantics"), marked into per-thread bitmaps over the scan's bounding box.
 
 #include <Eigen/Core>
 #include <cstdint>

@@ -1,5 +1,5 @@
 #pragma once
-// Private to the registration module: the Ceres residuals (STYLE.md F).
+// Private to the registration module: the Ceres residuals (docs/architecture.md, "Code style").
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>

@@ -1,6 +1,6 @@
 #pragma once
 
-// The one place that talks to Embree (private to the sim module, STYLE.md F).
+// The one place that talks to Embree (private to the sim module; docs/architecture.md, "Modules").
 #include <embree3/rtcore.h>
 
 #include <Eigen/Core>

@@ -2,7 +2,7 @@
 #pragma once
 
 // Strict reading of scene JSON (private): a missing key takes its default, an unknown key or a
-// wrong type is an error naming the file and the key path (STYLE.md, G).
+// wrong type is an error naming the file and the key path (docs/architecture.md, "Code style").
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 #include <set>

@@ -182,7 +182,7 @@ std::vector<WallTruth> WallTruths(const ObjectSpec& object, const WallSpec& wall
         const Eigen::Vector2d front = LeftNormal(frame.Direction(0.5 * (u0 + u1)));
         if (n.head<2>().dot(front) < 0.0) n = -n;
         t.plane << n, -n.dot(t.polygon[0]);
-        // Slant convention of ARCHITECTURE.md: arccos(|g . n|) with g = (0, 0, -1).
+        // Slant convention of docs/walls.md: arccos(|g . n|) with g = (0, 0, -1).
         t.slant_deg = RadToDeg(std::acos(std::min(1.0, std::abs(n.z()))));
         for (const Eigen::Vector2d& b : wall.path)
             t.base_path.emplace_back(b.x(), b.y(), wall.z_base);

@@ -1,7 +1,7 @@
 #pragma once
 
-// The one place the vehicles module talks to Embree (STYLE.md F): the map's surfaces as voxel
-// cubes, built once, queried from many threads.
+// The one place the vehicles module talks to Embree (docs/architecture.md, "Modules"): the map's
+// surfaces as voxel cubes, built once, queried from many threads.
 #include <embree3/rtcore.h>
 
 #include <Eigen/Core>

@@ -27,8 +27,8 @@ void WriteBytes(const std::filesystem::path& path, const char* data, size_t size
 
 /// @brief Aborts (a finding) on an exception that is not an accepted refusal: anything but a
 /// std::runtime_error or std::invalid_argument of exactly that type, the kinds the library's
-/// older code still throws until they become strata::Error kinds (STYLE.md); those too with
-/// STRATA_FUZZ_STRICT_KINDS=1.
+/// older code still throws until they become strata::Error kinds (docs/architecture.md,
+/// "Errors"); those too with STRATA_FUZZ_STRICT_KINDS=1.
 void RejectUnexpected(const std::exception& e);
 
 /// @brief Runs fn: a strata::Error means the reader refused the file, which is the accepted

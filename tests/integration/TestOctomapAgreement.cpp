@@ -1,6 +1,6 @@
-// Our maps equal OctoMap's insertPointCloud voxel for voxel and value for value (ARCHITECTURE.md,
-// "Integration semantics"; issue 23): every observed voxel of either map, its state and its
-// log-odds, on several synthetic scans (accumulation, clamping, rays through voxel corners) and
+// Our maps equal OctoMap's insertPointCloud voxel for voxel and value for value
+// (docs/integration.md, "Semantics"; issue 23): every observed voxel of either map, its state and
+// its log-odds, on several synthetic scans (accumulation, clamping, rays through voxel corners) and
 // on real KITTI and BALM scans at 0.2 and 0.1 m.
 #include <gtest/gtest.h>
 

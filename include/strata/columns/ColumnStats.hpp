@@ -24,9 +24,9 @@ struct ColumnStat {
     void Merge(const ColumnStat& other);
 };
 
-/// @brief Column statistics of a map straight from its VDB tree (ARCHITECTURE.md, "columns"):
-/// one entry per x/y voxel column holding an occupied voxel, on a dense 2D raster over the x/y
-/// bounding box of the occupied voxels. Only active voxels are visited, never a 3D box.
+/// @brief Column statistics of a map straight from its VDB tree (docs/walls.md, "Pipeline",
+/// stage 1): one entry per x/y voxel column holding an occupied voxel, on a dense 2D raster over
+/// the x/y bounding box of the occupied voxels. Only active voxels are visited, never a 3D box.
 /// @note Memory is sizeof(ColumnStat) (56 bytes) per column of the bounding box: 14 MB for a
 /// 100 m x 100 m map at 0.2 m. Process a large map tile by tile (the store's tiles are columns).
 class ColumnGrid {

@@ -9,8 +9,8 @@ namespace strata::core {
 
 struct VoxelMap;
 
-/// @brief What a voxel's endpoints left, packed into one Int32 of the `endpoints` grid
-/// (ARCHITECTURE.md, "Per-voxel data"): the hit count and the mean endpoint, always read together.
+/// @brief A voxel's hit count and mean endpoint, always read together, packed into one Int32 of
+/// the `endpoints` grid (docs/architecture.md, "Per-voxel grids and semantics").
 /// Bits 0-10: hits, saturating at kMaxHits. Bits 11-17, 18-24, 25-31: the mean's offset from the
 /// voxel centre along x, y, z, quantised to 127 levels of s/127 (q = 63 is the centre; the largest
 /// error of one rounding is s/254: 0.8 mm at 0.2 m). One grid of 4-byte leaves instead of a 4-byte

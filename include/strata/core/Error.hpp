@@ -1,8 +1,8 @@
 #pragma once
-// The kinds of failure the library reports (STYLE.md, "Errors"). Callers branch on the kind,
-// never on the message; the message names the file, argument or map at fault. The `strata`
-// program maps each kind to an exit code (tools/strata/Main.cpp, README "Exit codes"), the Python
-// module to an exception class of the same name.
+// The kinds of failure the library reports (docs/architecture.md, "Errors"). Callers branch on
+// the kind, never on the message; the message names the file, argument or map at fault. The
+// `strata` program maps each kind to an exit code (tools/strata/Main.cpp, README "Exit codes"),
+// the Python module to an exception class of the same name.
 
 #include <stdexcept>
 #include <string>

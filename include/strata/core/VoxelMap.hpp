@@ -10,7 +10,7 @@
 
 namespace strata::core {
 
-/// @brief Names of the grids of a map (ARCHITECTURE.md, "Per-voxel data").
+/// @brief Names of the grids of a map (docs/architecture.md, "Per-voxel grids and semantics").
 namespace grid_names {
 inline constexpr const char* kOccupancy = "occupancy";       ///< FloatGrid, log-odds
 inline constexpr const char* kLabel = "label";               ///< Int32Grid, SemanticClass

@@ -19,8 +19,8 @@ struct EndpointGroup {
     Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
 };
 
-/// @brief What one scan observed, before it touches a map (ARCHITECTURE.md, "Integration
-/// semantics"): every voxel at most once, occupied winning over free.
+/// @brief What one scan observed, before it touches a map (docs/integration.md, "Semantics"):
+/// every voxel at most once, occupied winning over free.
 struct ScanUpdate {
     openvdb::MaskTree::Ptr free;      ///< voxels the rays crossed, endpoints excluded; never null
     openvdb::MaskTree::Ptr occupied;  ///< endpoint voxels; never null

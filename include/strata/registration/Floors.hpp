@@ -18,8 +18,8 @@ struct FloorSlice {
     [[nodiscard]] Eigen::AlignedBox3d Box(double z_floor_m) const;
 };
 
-/// @brief How a floor mapped on its own is stacked on the floor below (ARCHITECTURE.md,
-/// "Multi-session and multi-floor"; docs/registration.md).
+/// @brief How a floor mapped on its own is stacked on the floor below (docs/registration.md,
+/// "Method", step 5).
 struct FloorStackConfig {
     double z_bias_m = 3.5;  ///< height of the floor above the reference floor
     FloorSlice slice;       ///< the walls both floors share lie in this band of each

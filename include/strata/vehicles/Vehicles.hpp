@@ -98,10 +98,10 @@ struct VehicleResult {
     double seconds = 0.0;
 };
 
-/// @brief Clears parked vehicles from a map and refills the ground they hid (ARCHITECTURE.md,
-/// "Vehicles and ground refill"): vehicle voxels from labels or the geometric detector,
-/// objects, L-shape boxes, clearing, ground refill from the ring around each box, Embree ray
-/// checks from the sensor origins (map frame) so that a cell seen empty stays empty.
+/// @brief Clears parked vehicles from a map and refills the ground they hid (docs/vehicles.md,
+/// "Pipeline"): vehicle voxels from labels or the geometric detector, objects, L-shape boxes,
+/// clearing, ground refill from the ring around each box, Embree ray checks from the sensor
+/// origins (map frame) so that a cell seen empty stays empty.
 /// @throw InvalidArgumentError for a map without grids or a bad config.
 [[nodiscard]] VehicleResult ClearVehicles(core::VoxelMap& map,
                                           const std::vector<Eigen::Vector3d>& origins_map,

@@ -10,7 +10,7 @@
 
 namespace strata::walls {
 
-/// @brief Grid names of the wall products (ARCHITECTURE.md, "Per-voxel data").
+/// @brief Grid names of the wall products (docs/architecture.md, "Per-voxel grids and semantics").
 namespace product_names {
 inline constexpr const char* kSlantDeg = "slant_deg";  ///< FloatGrid: slant of the voxel's wall
 inline constexpr const char* kWallId = "wall_id";      ///< Int32Grid: id of the voxel's wall

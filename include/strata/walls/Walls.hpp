@@ -203,9 +203,9 @@ private:
                                                          int radius, const WallConfig& config,
                                                          size_t* voting_columns = nullptr);
 
-/// @brief The whole pipeline on a map (ARCHITECTURE.md, "Walls and slant angles"): column
-/// statistics, voting, DBSCAN, K-means, RANSAC + wall tests per part, merge, SVD + Ceres per
-/// wall. Uses one thread. Throws InvalidArgumentError for a bad config or a map without
+/// @brief The whole pipeline on a map (docs/walls.md, "Pipeline"): column statistics, voting,
+/// DBSCAN, K-means, RANSAC + wall tests per part, merge, SVD + Ceres per wall. The stages after
+/// voting run in parallel (TBB). Throws InvalidArgumentError for a bad config or a map without
 /// occupancy.
 [[nodiscard]] WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config = {});
 
