@@ -5,6 +5,7 @@ function(strata_add_module)
   set(target strata_${ARG_NAME})
   add_library(${target} ${ARG_SOURCES})
   add_library(Strata::${ARG_NAME} ALIAS ${target})
+  set_property(GLOBAL APPEND PROPERTY STRATA_MODULE_TARGETS ${target})  # cmake/Install.cmake
   target_compile_features(${target} PUBLIC cxx_std_17)
   target_include_directories(${target}
     PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>

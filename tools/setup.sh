@@ -33,6 +33,7 @@ packages=(
   libopenmpi-dev openmpi-bin              # mpirun strata ... (docs/scale.md)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, docs/python.md)
   python3-matplotlib                      # docs/python.md's plotting example (tested)
+  groff-base                              # the install test reads the man pages (groff)
 )
 
 missing=()

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "Commands.hpp"
+#include "Version.hpp"
 #include "strata/core/Error.hpp"
 
 namespace {
@@ -68,9 +69,11 @@ int RunCommand(int argc, char** argv, const strata::pipeline::Ranks& ranks) {
         if (!SharesWork(argc, argv)) return EXIT_SUCCESS;  // rank 0 runs it alone
         quiet.emplace();
     }
-    CLI::App app{"strata: a GPU-free voxel database for LiDAR maps"};
+    // Named, so that the help says "Usage: strata ..." however the program was started (the man
+    // pages are made from it: tools/strata/HelpPages.py).
+    CLI::App app{"strata: a GPU-free voxel database for LiDAR maps", "strata"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "strata 0.1.0");
+    app.set_version_flag("--version", strata::tools::VersionText());
     strata::tools::RegisterIntegrate(app);
     strata::tools::RegisterInfo(app);
     strata::tools::RegisterExport(app);
