@@ -35,8 +35,7 @@ py::dict IntegrateInMemory(MemoryMap& m, const py::array& points, const py::arra
     integration::ScanUpdate update;
     {
         py::gil_scoped_release release;
-        update = integration::ComputeScanUpdate(scan, *m.map, m.config);
-        integration::ApplyScanUpdate(update, *m.map, m.config);
+        update = integration::Integrator(*m.map, m.config).Integrate(scan);
     }
     return UpdateCounts(update.points, update.dropped, update.clipped);
 }

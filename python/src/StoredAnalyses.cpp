@@ -169,7 +169,10 @@ py::array_t<double> Centers(const openvdb::BoolGrid::Ptr& mask, const core::Voxe
 py::dict Diff(const StoredMap& m, const std::string& from, const std::string& to,
               const py::object& region, const std::string& class_name, size_t min_voxels, int gap,
               int tolerance, int margin, int grow, int support) {
-    change::ChangeQuery query;
+    pipeline::DiffOptions options;
+    options.from = from;
+    options.to = to;
+    change::ChangeQuery& query = options.query;
     if (!region.is_none()) {
         std::string text = py::isinstance<py::str>(region) ? region.cast<std::string>() : "";
         if (text.empty()) {
@@ -180,10 +183,6 @@ py::dict Diff(const StoredMap& m, const std::string& from, const std::string& to
         query.region = core::Region::Parse(text);
     }
     if (!class_name.empty()) query.class_filter = core::ClassFromName(class_name);
-    if (min_voxels < 1) throw InvalidArgumentError("min_voxels must be at least 1");
-    if (gap < 0 || tolerance < 0 || margin < 0 || grow < 0 || support < 0) {
-        throw InvalidArgumentError("gap, tolerance, margin, grow and support must be >= 0");
-    }
     query.min_voxels = min_voxels;
     query.gap_voxels = gap;
     query.surface_tolerance_voxels = tolerance;
@@ -194,10 +193,7 @@ py::dict Diff(const StoredMap& m, const std::string& from, const std::string& to
     pipeline::DiffResult result;
     {
         py::gil_scoped_release release;
-        change::MapObserver observer(store, query.region);
-        const pipeline::DiffSide a = pipeline::ResolveSide(from, store, observer);
-        const pipeline::DiffSide b = pipeline::ResolveSide(to, store, observer);
-        result = pipeline::CompareSides(a, b, store, query);
+        result = pipeline::QueryChanges(store, options).result;
     }
     py::dict report = ParseJson(result.report);
     const core::VoxelMap frame = store.EmptyMap();

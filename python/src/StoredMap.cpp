@@ -59,14 +59,11 @@ StoredMap CreateStoredMap(const std::string& path, double voxel, double tile_siz
     request.tile_size_m = tile_size;
     if (!origin.is_none()) request.origin = Vector3FromObject(origin, "origin");
     request.rule = RuleFrom(max_range, min_range, points_only, keep_point_means);
-    const store::StoreSettings settings = pipeline::NewMapSettings(request);
-    if (MapStore::IsMap(path)) {
-        throw InvalidArgumentError(path + " holds a map already; open it with strata.Map.open");
-    }
-    StoredMap m;
-    m.config = settings.integration;  // recorded: every later session fuses alike
     py::gil_scoped_release release;
-    m.store = std::make_shared<MapStore>(MapStore::Create(path, settings));
+    pipeline::OpenedMap created = pipeline::CreateMap(path, request);
+    StoredMap m;
+    m.config = created.rule;  // recorded: every later session fuses alike
+    m.store = std::make_shared<MapStore>(std::move(created.map));
     return m;
 }
 
@@ -89,10 +86,11 @@ std::string ExportStoredMap(const StoredMap& self, const std::string& path,
                             const std::string& format, const std::string& as_of) {
     pipeline::ExportOptions options;
     options.format = format;
-    (void)pipeline::ExportFormat(path, options);  // a bad name fails before any read
-    const MemoryMap snapshot = self.Load(as_of);
+    options.memory_budget_bytes = 0;  // as Map.load: the whole snapshot in memory when it must be
+    const MapStore& store = self.Get();
     py::gil_scoped_release release;
-    return pipeline::ExportMap(*snapshot.map, path, options);
+    return pipeline::ExportStored(store, pipeline::SelectSnapshot(store, as_of), path, options)
+        .format;
 }
 
 py::object Info(const StoredMap& self, const std::string& as_of) {

@@ -9,8 +9,21 @@ const char* ChangeKindName(ChangeKind kind) {
     return kind == ChangeKind::kAdded ? "added" : "removed";
 }
 
+void ChangeQuery::Validate() const {
+    if (min_voxels < 1) throw InvalidArgumentError("min_voxels must be at least 1");
+    if (gap_voxels < 0) throw InvalidArgumentError("gap_voxels must be >= 0");
+    if (surface_tolerance_voxels < 0) {
+        throw InvalidArgumentError("surface_tolerance_voxels must be >= 0");
+    }
+    if (observed_margin_voxels < 0)
+        throw InvalidArgumentError("observed_margin_voxels must be >= 0");
+    if (support_depth_voxels < 0) throw InvalidArgumentError("support_depth_voxels must be >= 0");
+    if (grow_voxels < 0) throw InvalidArgumentError("grow_voxels must be >= 0");
+}
+
 ChangeSet DetectChanges(const Observation& a, const Observation& b, double voxel_size,
                         const ChangeQuery& query) {
+    query.Validate();
     detail::Require(a, "A");
     detail::Require(b, "B");
     if (!(voxel_size > 0.0)) throw InvalidArgumentError("change detection: voxel size <= 0");

@@ -107,6 +107,7 @@ TiledSide WholeSide(Observation observation, const store::MapSettings& settings)
 
 ChangeSet DetectChangesByTiles(const TiledSide& a, const TiledSide& b,
                                const store::MapSettings& settings, const ChangeQuery& query) {
+    query.Validate();
     const double s = settings.voxel_size_m;
     if (!(s > 0.0)) throw InvalidArgumentError("change detection: voxel size <= 0");
     std::set<store::TileKey> union_keys(a.tiles.begin(), a.tiles.end());

@@ -27,6 +27,23 @@ DiffResult CompareSides(const DiffSide& a, const DiffSide& b, const store::MapSt
     return result;
 }
 
+void DiffOptions::Validate() const {
+    query.Validate();
+    if (to_scans) to_scans->Validate();
+}
+
+DiffOutcome QueryChanges(const store::MapStore& map, const DiffOptions& options) {
+    options.Validate();
+    DiffOutcome outcome;
+    outcome.observer = std::make_unique<change::MapObserver>(map, options.query.region,
+                                                             options.memory_budget_bytes);
+    outcome.a = ResolveSide(options.from, map, *outcome.observer);
+    outcome.b = options.to_scans ? ObserveScans(map, *options.to_scans)
+                                 : ResolveSide(options.to, map, *outcome.observer);
+    outcome.result = CompareSides(outcome.a, outcome.b, map, options.query);
+    return outcome;
+}
+
 DiffSide ObserveScans(const store::MapStore& map, const ScanSpec& scans) {
     const ScanSource source = ScanSource::Open(scans, map.settings().origin);
     core::VoxelMap scratch = map.EmptyMap();  // the Observation shares its grids

@@ -22,13 +22,17 @@ store::StoreSettings NewMapSettings(const MapRequest& request) {
     return settings;
 }
 
+OpenedMap CreateMap(const std::filesystem::path& dir, const MapRequest& request) {
+    const store::StoreSettings settings = NewMapSettings(request);
+    if (store::MapStore::IsMap(dir)) {
+        throw InvalidArgumentError(dir.string() + " holds a map already; open it instead");
+    }
+    return {store::MapStore::Create(dir, settings), true, settings.integration};
+}
+
 OpenedMap OpenOrCreateMap(const std::filesystem::path& dir, const MapRequest& request) {
     request.rule.Validate();
-    if (!store::MapStore::IsMap(dir)) {
-        store::StoreSettings settings = NewMapSettings(request);
-        integration::IntegrationConfig rule = settings.integration;
-        return {store::MapStore::Create(dir, settings), true, rule};
-    }
+    if (!store::MapStore::IsMap(dir)) return CreateMap(dir, request);
     OpenedMap opened{store::MapStore::Open(dir, store::MapStore::Access::kWrite), false, {}};
     opened.rule = ResolveRule(opened.map.settings(), dir.string(), request.rule);
     const double voxel = opened.map.settings().voxel_size_m;

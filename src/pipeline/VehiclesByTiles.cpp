@@ -335,7 +335,9 @@ VehiclesOutcome ClearVehiclesByTiles(const store::MapStore& map, const store::Sn
             ranks.Gather(ranks.root() ? "" : EncodeWindows(found, result.ground_columns));
         if (!ranks.root()) return outcome;
         for (size_t r = 1; r < all.size(); ++r) {
-            found.push_back(DecodeWindows(all[r], result.ground_columns));
+            for (vehicles::WindowVehicles& w : DecodeWindows(all[r], result.ground_columns)) {
+                found.push_back(std::move(w));
+            }
         }
     }
     // Ids in key order, as the whole map numbers its vehicles.

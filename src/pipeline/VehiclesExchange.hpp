@@ -1,6 +1,6 @@
 #pragma once
 // What a rank found of the vehicles (pipeline::ClearVehiclesOnRanks), in bytes for rank 0
-// (docs/scale.md): flat records, no pointers.
+// (docs/scale.md), written and read with core/Bytes.hpp.
 
 #include <cstddef>
 #include <string>
@@ -13,11 +13,11 @@ namespace strata::pipeline::detail {
 /// @brief The blocks a rank cleared and the measured ground columns of their cores.
 [[nodiscard]] std::string EncodeWindows(const std::vector<vehicles::WindowVehicles>& found,
                                         size_t ground_columns);
-/// @brief One rank's EncodeWindows as one WindowVehicles; its ground columns are added to
+/// @brief One rank's EncodeWindows: its blocks, in its order; its ground columns are added to
 /// `ground_columns`.
 /// @throw FormatError when the bytes are cut short.
-[[nodiscard]] vehicles::WindowVehicles DecodeWindows(const std::string& bytes,
-                                                     size_t& ground_columns);
+[[nodiscard]] std::vector<vehicles::WindowVehicles> DecodeWindows(const std::string& bytes,
+                                                                  size_t& ground_columns);
 
 /// @brief The long objects' samples of a rank's windows.
 [[nodiscard]] std::string EncodeSamples(const std::vector<vehicles::ObjectSample>& samples);

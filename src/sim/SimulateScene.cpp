@@ -14,11 +14,26 @@ namespace strata::sim {
 namespace {
 
 SensorModel MakeSensor(const SceneSpec& scene, const SimulateConfig& config) {
+    config.Validate();
     SensorModel sensor =
         SensorModel::FromName(config.sensor.empty() ? scene.sensor : config.sensor);
     if (config.range_noise_m) sensor.range_noise_m = *config.range_noise_m;
     sensor.Validate();
     return sensor;
+}
+
+const SessionSpec& SessionOf(const SceneSpec& spec, size_t session) {
+    if (session >= spec.sessions.size()) {
+        throw InvalidArgumentError("the scene has " + std::to_string(spec.sessions.size()) +
+                                   " session(s); session " + std::to_string(session) +
+                                   " does not exist");
+    }
+    return spec.sessions[session];
+}
+
+TrajectorySpec Capped(TrajectorySpec trajectory, int max_scans) {
+    if (max_scans > 0) trajectory.max_scans = std::min(trajectory.max_scans, max_scans);
+    return trajectory;
 }
 
 // Indoors (something above the first pose) the picture is cut just above the sensor, so that
@@ -36,35 +51,27 @@ PictureConfig PictureFor(const Simulator& simulator, const std::vector<ScanPose>
 }
 
 SessionReport SimulateSession(const SceneSpec& spec, size_t s, const std::filesystem::path& dir,
-                              const SimulateConfig& config, const SensorModel& sensor,
+                              const SimulateConfig& config,
                               const std::function<void()>& scan_done) {
-    const SessionSpec& session = spec.sessions[s];
-    Scene scene = BuildScene(spec, s);
-    const Simulator simulator(scene);
-    TrajectorySpec trajectory = session.trajectory;
-    if (config.max_scans > 0)
-        trajectory.max_scans = std::min(trajectory.max_scans, config.max_scans);
-    const std::vector<ScanPose> poses = PlanScanPoses(trajectory, simulator, sensor.rate_hz);
-    const Eigen::Isometry3d T_session_world = session.T_world_session.inverse();
-    const uint64_t seed = config.seed.value_or(spec.seed);
+    SessionSimulation run(spec, s, config);
+    Scene& scene = run.scene();
+    const Simulator& simulator = run.simulator();
+    const std::vector<ScanPose>& poses = run.poses();
+    const SensorModel& sensor = run.sensor();
+    const Eigen::Isometry3d T_session_world = spec.sessions[s].T_world_session.inverse();
+    const uint64_t seed = run.seed();
 
     SessionReport report;
-    report.name = session.name;
+    report.name = spec.sessions[s].name;
     report.dir = dir;
     report.triangles = scene.TriangleCount();
     SequenceWriter writer(dir);
     for (size_t k = 0; k < poses.size(); ++k) {
-        SweepRequest request;
-        request.T_world_sensor = poses[k].T_world_sensor;
-        if (config.motion) request.T_world_sensor_end = poses[k].T_world_sensor_end;
-        request.seed = seed;
-        request.scan_index = (uint64_t(s) << 32) | k;
-        request.time_s = poses[k].time_s;
         const auto start = std::chrono::steady_clock::now();
-        const SimulatedScan scan = simulator.SimulateSweep(request, sensor);
+        const SimulatedScan scan = run.Sweep(k);
         report.trace_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        writer.Add(scan, T_session_world * poses[k].T_world_sensor);
+        writer.Add(scan, run.T_session_sensor(k));
         report.points += scan.scan.points.size();
         report.rays += scan.rays;
         if (scan_done) scan_done();
@@ -102,6 +109,33 @@ SessionReport SimulateSession(const SceneSpec& spec, size_t s, const std::filesy
 
 }  // namespace
 
+SessionSimulation::SessionSimulation(const SceneSpec& spec, size_t session,
+                                     const SimulateConfig& config)
+    : T_session_world_(SessionOf(spec, session).T_world_session.inverse()),
+      session_(session),
+      motion_(config.motion),
+      sensor_(MakeSensor(spec, config)),
+      seed_(config.seed.value_or(spec.seed)),
+      scene_(BuildScene(spec, session)),
+      simulator_(scene_),
+      poses_(PlanScanPoses(Capped(spec.sessions[session].trajectory, config.max_scans), simulator_,
+                           sensor_.rate_hz)) {}
+
+SimulatedScan SessionSimulation::Sweep(size_t k) const {
+    const ScanPose& pose = poses_.at(k);
+    SweepRequest request;
+    request.T_world_sensor = pose.T_world_sensor;
+    if (motion_) request.T_world_sensor_end = pose.T_world_sensor_end;
+    request.seed = seed_;
+    request.scan_index = (uint64_t{session_} << 32) | k;  // one noise stream per sweep
+    request.time_s = pose.time_s;
+    return simulator_.SimulateSweep(request, sensor_);
+}
+
+Eigen::Isometry3d SessionSimulation::T_session_sensor(size_t k) const {
+    return T_session_world_ * poses_.at(k).T_world_sensor;
+}
+
 void SimulateConfig::Validate() const {
     if (!sensor.empty()) (void)SensorModel::FromName(sensor);
     if (max_scans < 0) throw InvalidArgumentError("max_scans must be >= 0");
@@ -119,7 +153,7 @@ SimulateReport SimulateSceneToSequence(const SceneSpec& scene, const std::filesy
                                        const SimulateProgress& progress) {
     config.Validate();
     scene.Validate();
-    const SensorModel sensor = MakeSensor(scene, config);
+    (void)MakeSensor(scene, config);  // a bad sensor fails before any session is built
     size_t total = 0, done = 0;
     for (const SessionSpec& s : scene.sessions) {
         const int cap = config.max_scans > 0 ? std::min(config.max_scans, s.trajectory.max_scans)
@@ -133,7 +167,7 @@ SimulateReport SimulateSceneToSequence(const SceneSpec& scene, const std::filesy
     for (size_t s = 0; s < scene.sessions.size(); ++s) {
         const std::filesystem::path dir =
             scene.sessions.size() == 1 ? out_dir : out_dir / ("session_" + std::to_string(s));
-        report.sessions.push_back(SimulateSession(scene, s, dir, config, sensor, scan_done));
+        report.sessions.push_back(SimulateSession(scene, s, dir, config, scan_done));
     }
     if (progress) progress(total, total);
     return report;

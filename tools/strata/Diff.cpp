@@ -10,7 +10,6 @@
 #include "Commands.hpp"
 #include "MapAccess.hpp"
 #include "strata/change/ChangeReport.hpp"
-#include "strata/change/MapObserver.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::tools {
@@ -91,13 +90,20 @@ void Run(const DiffArgs& args) {
     }
     if (args.from.empty() && !scans) throw InvalidArgumentError("--from SIDE is required");
     if (args.memory_budget_mb < 0.0) throw InvalidArgumentError("--memory-budget must be >= 0");
-    if (args.min_voxels < 1) throw InvalidArgumentError("--min-voxels must be at least 1");
-    if (args.gap < 0) throw InvalidArgumentError("--gap must be >= 0");
-    if (args.tolerance < 0 || args.margin < 0 || args.grow < 0 || args.support < 0) {
-        throw InvalidArgumentError("--tolerance, --margin, --grow and --support must be >= 0");
-    }
 
-    change::ChangeQuery query;
+    pipeline::DiffOptions options;
+    options.from = args.from.empty() ? "map" : args.from;
+    if (scans) {
+        pipeline::ScanSpec to_scans;
+        to_scans.kitti = args.to_kitti;
+        to_scans.frames = args.frames;
+        to_scans.files = {args.to_scans.begin(), args.to_scans.end()};
+        to_scans.poses = args.poses;
+        options.to_scans = to_scans;
+    } else {
+        options.to = args.to;
+    }
+    change::ChangeQuery& query = options.query;
     if (!args.region.empty()) query.region = core::Region::Parse(args.region);
     if (!args.class_name.empty()) query.class_filter = core::ClassFromName(args.class_name);
     query.min_voxels = args.min_voxels;
@@ -106,24 +112,16 @@ void Run(const DiffArgs& args) {
     query.observed_margin_voxels = args.margin;
     query.grow_voxels = args.grow;
     query.support_depth_voxels = args.support;
+    options.memory_budget_bytes = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    options.Validate();  // QueryChanges checks again; here bad options fail before the map opens
 
     // --save writes the catalog: open as the writer up front, so a busy map fails before work.
     store::MapStore map = OpenMap(
         args.map, args.save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    change::MapObserver observer(map, query.region,
-                                 static_cast<size_t>(args.memory_budget_mb * 1e6));
-    const Side a = pipeline::ResolveSide(args.from.empty() ? "map" : args.from, map, observer);
-    pipeline::ScanSpec to_scans;
-    to_scans.kitti = args.to_kitti;
-    to_scans.frames = args.frames;
-    to_scans.files = {args.to_scans.begin(), args.to_scans.end()};
-    to_scans.poses = args.poses;
-    const Side b = scans ? pipeline::ObserveScans(map, to_scans)
-                         : pipeline::ResolveSide(args.to, map, observer);
-
-    const pipeline::DiffResult diff = pipeline::CompareSides(a, b, map, query);
-    const change::ChangeSet& changes = diff.changes;
-    const std::string& report = diff.report;
+    const pipeline::DiffOutcome diff = pipeline::QueryChanges(map, options);
+    const Side& a = diff.a;
+    const Side& b = diff.b;
+    const change::ChangeSet& changes = diff.result.changes;
     const change::ReportContext context{a.name, b.name, map.settings().origin, &query};
     if (!args.vdb.empty()) change::WriteChangeVdb(changes, context, args.vdb);
     if (!args.png.empty()) {
@@ -131,12 +129,12 @@ void Run(const DiffArgs& args) {
         change::WriteChangePng(changes, *seen, args.png);
     }
     if (args.json) {
-        std::cout << report;
+        std::cout << diff.result.report;
     } else {
         PrintSummary(changes, a, b);
     }
     if (args.save) {
-        const int64_t id = pipeline::SaveChangeSet(map, a, b, diff);
+        const int64_t id = pipeline::SaveChangeSet(map, a, b, diff.result);
         (args.json ? std::cerr : std::cout) << "saved as change set " << id << "\n";
     }
 }

@@ -52,6 +52,9 @@ struct ChangeQuery {
     /// roof edge above the other side's highest rays); candidates with no such group near them
     /// stay out. 0 disables.
     int grow_voxels = 2;
+
+    /// @brief Throws InvalidArgumentError naming the first bad field.
+    void Validate() const;
 };
 
 enum class ChangeKind { kAdded, kRemoved };
@@ -101,7 +104,8 @@ struct ChangeSet {
 /// voxels near a surface of the other side (`surface_tolerance_voxels`) and on the rim of what it
 /// observed (`observed_margin_voxels`); a voxel unobserved by either side is unknown, never
 /// changed. Changed voxels are grouped into objects.
-/// @throws InvalidArgumentError when a mask is missing or `voxel_size` is not positive.
+/// @throws InvalidArgumentError when a mask is missing, `voxel_size` is not positive or the query
+/// is invalid (ChangeQuery::Validate).
 [[nodiscard]] ChangeSet DetectChanges(const Observation& a, const Observation& b, double voxel_size,
                                       const ChangeQuery& query = {});
 

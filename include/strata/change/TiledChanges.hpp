@@ -29,7 +29,7 @@ struct TiledSide {
 /// formed across tile borders, growth runs tile by tile again, and objects are grouped across
 /// borders. The same voxels, objects and counts as DetectChanges on the whole sides (tested);
 /// memory holds a few tiles' observations and the changed voxels, not the map.
-/// @throws InvalidArgumentError for a bad voxel size; what a side's `observe` throws.
+/// @throws InvalidArgumentError for a bad voxel size or query; what a side's `observe` throws.
 [[nodiscard]] ChangeSet DetectChangesByTiles(const TiledSide& a, const TiledSide& b,
                                              const store::MapSettings& settings,
                                              const ChangeQuery& query = {});

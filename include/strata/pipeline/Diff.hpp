@@ -2,6 +2,7 @@
 // Change queries against a stored map (docs/change.md): `strata diff` and Python's Map.diff.
 
 #include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -11,6 +12,7 @@
 #include "strata/change/TiledChanges.hpp"
 #include "strata/pipeline/ScanSource.hpp"
 #include "strata/store/MapStore.hpp"
+#include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline {
 
@@ -38,6 +40,34 @@ struct DiffResult {
 /// and thresholds) tile by tile, a few tiles in memory at a time, and writes the report.
 [[nodiscard]] DiffResult CompareSides(const DiffSide& a, const DiffSide& b,
                                       const store::MapStore& map, const change::ChangeQuery& query);
+
+/// @brief A change query as `strata diff` and Python's Map.diff ask it.
+struct DiffOptions {
+    std::string from = "map";          ///< side A, as ResolveSide reads it
+    std::string to = "map";            ///< side B, as ResolveSide reads it; unused with `to_scans`
+    std::optional<ScanSpec> to_scans;  ///< side B: scans not yet integrated (ObserveScans)
+    change::ChangeQuery query;         ///< region, class filter and thresholds
+    /// Decoded tiles kept cached between the sides (change::MapObserver).
+    size_t memory_budget_bytes = store::TileReader::kDefaultBudgetBytes;
+
+    /// @brief Throws InvalidArgumentError naming the first bad field.
+    void Validate() const;
+};
+
+/// @brief A comparison with its sides. The sides read through `observer`, kept here so that
+/// SeenOccupied can still read them; none of it may outlive the map.
+struct DiffOutcome {
+    std::unique_ptr<change::MapObserver> observer;
+    DiffSide a;
+    DiffSide b;
+    DiffResult result;
+};
+
+/// @brief The change query of `strata diff` and Map.diff: validates `options`, resolves side A
+/// and then side B (ResolveSide, or ObserveScans for `to_scans`) and compares them
+/// (CompareSides). The map is only read.
+/// @throw InvalidArgumentError for bad options; the errors of ResolveSide and ObserveScans.
+[[nodiscard]] DiffOutcome QueryChanges(const store::MapStore& map, const DiffOptions& options);
 
 /// @brief Scans not yet integrated as a side: integrated in memory with the map's voxel size,
 /// origin and integration rule (so both sides weigh evidence alike); the map is only read.

@@ -32,7 +32,12 @@ struct OpenedMap {
 /// @throw InvalidArgumentError for an invalid rule; the reader's errors for the LAS header.
 [[nodiscard]] store::StoreSettings NewMapSettings(const MapRequest& request);
 
-/// @brief Opens the map in `dir` for writing, or creates it when there is none.
+/// @brief Creates a map in `dir` with NewMapSettings(request), open for writing.
+/// @throw InvalidArgumentError when `dir` holds a map already or for an invalid rule;
+/// NewMapSettings' and the store's errors.
+[[nodiscard]] OpenedMap CreateMap(const std::filesystem::path& dir, const MapRequest& request);
+
+/// @brief Opens the map in `dir` for writing, or creates it when there is none (CreateMap).
 /// @throw InvalidArgumentError when the request conflicts with an existing map (its voxel size
 /// or a rule field, see ResolveRule); the store's errors (MapLockedError, FormatError, ...).
 [[nodiscard]] OpenedMap OpenOrCreateMap(const std::filesystem::path& dir,

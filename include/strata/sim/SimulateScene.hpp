@@ -7,8 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "strata/sim/Scene.hpp"
 #include "strata/sim/ScenePicture.hpp"
 #include "strata/sim/SceneSpec.hpp"
+#include "strata/sim/SensorModel.hpp"
+#include "strata/sim/Simulator.hpp"
+#include "strata/sim/Trajectory.hpp"
 
 namespace strata::sim {
 
@@ -26,6 +30,39 @@ struct SimulateConfig {
 
     /// @brief Throws InvalidArgumentError for an unknown sensor or out-of-range values.
     void Validate() const;
+};
+
+/// @brief One session of a scene simulated sweep by sweep as SimulateSceneToSequence simulates it
+/// (the same scene, poses, sensor and noise seeds), so a caller that takes the sweeps one at a
+/// time (Python's strata.simulate) gets what the written sequence holds.
+class SessionSimulation {
+public:
+    /// @brief Builds the session's scene (BuildScene) and plans its sweeps.
+    /// @throw InvalidArgumentError for a session the scene does not have or a bad config.
+    SessionSimulation(const SceneSpec& spec, size_t session, const SimulateConfig& config);
+
+    [[nodiscard]] size_t size() const { return poses_.size(); }
+    /// @brief Sweep k: points in the sensor frame, the pose in the world frame.
+    [[nodiscard]] SimulatedScan Sweep(size_t k) const;
+    /// @brief Where sweep k starts in the session's frame: what the sequence's poses record.
+    [[nodiscard]] Eigen::Isometry3d T_session_sensor(size_t k) const;
+
+    /// @brief The session's scene; its ground truth is the caller's to complete.
+    [[nodiscard]] Scene& scene() { return scene_; }
+    [[nodiscard]] const Simulator& simulator() const { return simulator_; }
+    [[nodiscard]] const std::vector<ScanPose>& poses() const { return poses_; }
+    [[nodiscard]] const SensorModel& sensor() const { return sensor_; }
+    [[nodiscard]] uint64_t seed() const { return seed_; }
+
+private:
+    Eigen::Isometry3d T_session_world_;  // first: checks the session before anything is built
+    size_t session_;
+    bool motion_;
+    SensorModel sensor_;
+    uint64_t seed_;
+    Scene scene_;
+    Simulator simulator_;
+    std::vector<ScanPose> poses_;
 };
 
 /// @brief What was written for one session.

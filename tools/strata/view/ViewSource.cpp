@@ -1,6 +1,8 @@
-// The viewer's only use of the map store (ViewSource.hpp): snapshots pinned from MapStore (format
-// 5), tiles read through store::TileReader (fused grids, each session's layers, the walls and
-// vehicles products), and the analyses' rows as the store keeps them (ProductHistory).
+// The viewer's only use of the map store (ViewSource.hpp): the map opened and its sessions found
+// as every command does (pipeline/MapAccess.hpp), snapshots pinned from MapStore (format 5), tiles
+// read through store::TileReader (fused grids, each session's layers, the walls and vehicles
+// products), the analyses' rows as the store keeps them (ProductHistory), and the saved change
+// sets as `strata diff --list` reads them (pipeline::ChangeSetsJson).
 #include "ViewSource.hpp"
 
 #include <algorithm>
@@ -11,22 +13,14 @@
 #include "strata/change/ChangeReport.hpp"
 #include "strata/change/MapObserver.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/pipeline/Diff.hpp"
+#include "strata/pipeline/MapAccess.hpp"
 #include "strata/store/MapStore.hpp"
 #include "strata/store/TileReader.hpp"
 #include "strata/vehicles/Vehicles.hpp"
 #include "strata/walls/WallReport.hpp"
 
 namespace strata::view {
-
-// A saved change set (`strata diff --save`, tools/strata/Diff.cpp): its sides and counts. Not in
-// the anonymous namespace: ViewSource::Impl holds them.
-struct ChangeSetRow {
-    int64_t id = 0;
-    int64_t commit = 0;
-    std::string from, to;
-    size_t added_voxels = 0, removed_voxels = 0, objects = 0;
-    nlohmann::json report;
-};
 
 namespace {
 
@@ -88,26 +82,6 @@ json VehicleJson(const json& v, int64_t commit) {
             {"refused_cells", v.value("refused_cells", 0)}};
 }
 
-ChangeSetRow ChangeSetOf(const json& j, const store::ProductRow& r) {
-    ChangeSetRow c;
-    c.id = r.id;
-    c.commit = r.commit;
-    c.from = j.value("from_side", "");
-    c.to = j.value("to_side", "");
-    c.added_voxels = j.value("added_voxels", size_t{0});
-    c.removed_voxels = j.value("removed_voxels", size_t{0});
-    c.objects = j.value("objects", size_t{0});
-    c.report = j.value("report", json());
-    return c;
-}
-
-// The row of a saved change set; its counts are in the report (added_voxels, removed_voxels,
-// unknown_voxels, objects).
-json ChangeSetJson(const ChangeSetRow& r, const std::string& created_utc) {
-    return {{"id", r.id},     {"commit", r.commit}, {"created_utc", created_utc},
-            {"from", r.from}, {"to", r.to},         {"report", r.report}};
-}
-
 template <typename GridT>
 typename GridT::ConstPtr Product(const openvdb::GridPtrVec& grids, const char* name) {
     for (const openvdb::GridBase::Ptr& grid : grids) {
@@ -141,19 +115,6 @@ change::ChangeQuery QueryOf(const json& report) {
     return q;
 }
 
-// The session `id_or_name` names (MapStore::FindSession), or NotFoundError listing the sessions.
-int64_t SessionNamed(const store::MapStore& store, const std::string& id_or_name) {
-    std::string known;
-    for (const auto& [session, removed_by] : store.SessionHistory()) {
-        if (std::to_string(session.id) == id_or_name || session.name == id_or_name) {
-            return store.FindSession(id_or_name);
-        }
-        known += (known.empty() ? "" : ", ") + std::to_string(session.id) + " " + session.name;
-    }
-    throw NotFoundError(store.dir().string() + ": no session '" + id_or_name +
-                        "' (sessions: " + (known.empty() ? "none" : known) + ")");
-}
-
 }  // namespace
 
 struct ViewSource::Impl {
@@ -169,8 +130,7 @@ struct ViewSource::Impl {
     json sessions = json::array();
     json walls = json::array();
     json vehicles = json::array();
-    json change_sets = json::array();
-    std::vector<ChangeSetRow> change_set_records;
+    json change_sets = json::array();    ///< pipeline::ChangeSetsJson's entries up to the commit
     std::map<TileRef, size_t> versions;  ///< every fused version a snapshot names: its reader
     mutable std::mutex catalog;          ///< one catalog reader at a time (change queries)
 
@@ -215,19 +175,16 @@ ViewSource::ViewSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 ViewSource::~ViewSource() = default;
 
 std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::string& as_of) {
-    if (!store::MapStore::IsMap(dir)) {
-        throw NotFoundError(dir.string() + ": no map here (create one with `strata integrate " +
-                            dir.string() + " --kitti SEQ` or `strata demo`)");
-    }
-    auto impl = std::make_unique<Impl>(store::MapStore::Open(dir, store::MapStore::Access::kRead));
+    auto impl = std::make_unique<Impl>(pipeline::OpenMap(dir));
     Impl& s = *impl;
     const store::MapSettings& settings = s.store.settings();
     s.facts = {fs::absolute(dir).lexically_normal().filename().string(), settings.voxel_size_m,
                settings.tile_voxels, settings.origin, settings.format_version};
     if (s.facts.name.empty()) s.facts.name = fs::absolute(dir).parent_path().filename().string();
 
-    const int64_t as_of_id = as_of.empty() ? 0 : SessionNamed(s.store, as_of);
-    s.Pin(as_of.empty() ? s.store.Latest() : s.store.AsOf(as_of_id), as_of_id);
+    // pipeline::SelectSnapshot's choice; the session's id names the snapshot in the page.
+    const int64_t as_of_id = as_of.empty() ? 0 : s.store.FindSession(as_of);
+    s.Pin(pipeline::SelectSnapshot(s.store, as_of), as_of_id);
     const int64_t commit = s.snapshots.front().commit;
     // The map right after each session, as far as the map keeps its history (strata gc).
     const int64_t history_start = s.store.HistoryStart();
@@ -247,11 +204,8 @@ std::shared_ptr<ViewSource> ViewSource::Open(const fs::path& dir, const std::str
     for (const store::ProductRow& r : s.store.ProductRowsAt("vehicles", commit)) {
         s.vehicles.push_back(VehicleJson(RowObject(s.store, "vehicles", r), r.commit));
     }
-    for (const store::ProductRow& r : s.store.ProductHistory("change_sets")) {
-        if (r.commit > commit) continue;
-        const ChangeSetRow row = ChangeSetOf(RowObject(s.store, "change_sets", r), r);
-        s.change_sets.push_back(ChangeSetJson(row, r.time_utc));
-        s.change_set_records.push_back(row);
+    for (const json& set : pipeline::ChangeSetsJson(s.store)) {
+        if (set.at("commit").get<int64_t>() <= commit) s.change_sets.push_back(set);
     }
     return std::shared_ptr<ViewSource>(new ViewSource(std::move(impl)));
 }
@@ -316,24 +270,25 @@ ChangeMasks ViewSource::DiffSessions(int64_t a, int64_t b) const {
 }
 
 std::optional<ChangeMasks> ViewSource::ChangeSetVoxels(int64_t id) const {
-    const auto& records = impl_->change_set_records;
-    const auto it = std::find_if(records.begin(), records.end(),
-                                 [&](const ChangeSetRow& r) { return r.id == id; });
-    if (it == records.end()) throw NotFoundError("no change set " + std::to_string(id));
-    const json& report = it->report;
+    const json& sets = impl_->change_sets;
+    const auto it =
+        std::find_if(sets.begin(), sets.end(), [&](const json& set) { return set.at("id") == id; });
+    if (it == sets.end()) throw NotFoundError("no change set " + std::to_string(id));
+    const json report = it->value("report", json());
     if (!report.is_object()) return std::nullopt;
+    const auto commit = it->at("commit").get<int64_t>();
     const std::lock_guard<std::mutex> lock(impl_->catalog);
     change::MapObserver observer(impl_->store);
-    const auto before = impl_->Side(it->from, it->commit, observer);
-    const auto after = impl_->Side(it->to, it->commit, observer);
+    const auto before = impl_->Side(it->value("from", ""), commit, observer);
+    const auto after = impl_->Side(it->value("to", ""), commit, observer);
     if (!before || !after) return std::nullopt;
     const change::ChangeQuery query = QueryOf(report);
     const change::ChangeSet changes =
         change::DetectChanges(*before, *after, impl_->facts.voxel_size_m, query);
     // Only the voxels the record describes: the same counts and objects, or none at all.
-    if (changes.added_voxels_total != it->added_voxels ||
-        changes.removed_voxels_total != it->removed_voxels ||
-        changes.objects.size() != it->objects) {
+    if (changes.added_voxels_total != it->value("added_voxels", size_t{0}) ||
+        changes.removed_voxels_total != it->value("removed_voxels", size_t{0}) ||
+        changes.objects.size() != it->value("objects", size_t{0})) {
         return std::nullopt;
     }
     return ChangeMasks{{changes.added, changes.removed, after->labels, before->labels}, report};

@@ -57,7 +57,8 @@ struct ChangeMasks {
 /// process are not seen. Thread-safe: catalog reads are serialised, tile reads run in parallel.
 class ViewSource {
 public:
-    /// @throw NotFoundError when `dir` holds no map; the store's errors otherwise.
+    /// @throw NotFoundError when `dir` does not exist (pipeline::OpenMap); the store's errors
+    /// otherwise (FormatError for a directory that holds no map).
     [[nodiscard]] static std::shared_ptr<ViewSource> Open(const std::filesystem::path& dir,
                                                           const std::string& as_of = "");
     ~ViewSource();
