@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -24,6 +26,26 @@ inline double Median(std::vector<double> v) {
 }
 
 using Clock = std::chrono::steady_clock;
+
+/// The exit status of a benchmark that could not measure because real data is missing: 1 under
+/// STRATA_REQUIRE_DATA=1 (CI, as tests/support/RealData.hpp fails a test), else 77, which CTest
+/// reports as a skip (SKIP_RETURN_CODE) and a person running it by hand sees as a failure.
+/// Measuring nothing is never a pass. Prints which data is missing.
+inline int MissingDataStatus(const char* program, const std::filesystem::path& missing) {
+    const char* require = std::getenv("STRATA_REQUIRE_DATA");
+    const bool required = require != nullptr && std::strcmp(require, "1") == 0;
+    std::fprintf(stderr, "%s: real data not found: %s (%s; see ../shared/data/README.md)\n",
+                 program, missing.c_str(),
+                 required ? "STRATA_REQUIRE_DATA=1: a failure" : "nothing measured, exit 77");
+    return required ? 1 : 77;
+}
+
+/// The exit status of a benchmark run: 1 when a target was missed, else MissingDataStatus's when
+/// some data was missing (`missing` not empty), else 0.
+inline int ExitStatus(const char* program, bool missed, const std::filesystem::path& missing) {
+    if (missed) return 1;
+    return missing.empty() ? 0 : MissingDataStatus(program, missing);
+}
 
 /// Seconds elapsed since `start`.
 inline double Seconds(Clock::time_point start) {

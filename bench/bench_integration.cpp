@@ -1,6 +1,7 @@
 // Integration benchmark: our Integrator against OctoMap's insertPointCloud on the same points,
 // in the same process. Prints one docs/bench.md table row per (dataset, voxel size) and exits 1
-// when any voxel differs from OctoMap's (state, or log-odds by more than 1e-5).
+// when any voxel differs from OctoMap's (state, or log-odds by more than 1e-5) or a row misses
+// its documented figures (kDocumented).
 //
 //   bench_integration [DATA_DIR] [--scans N] [--voxel S ...] [--strata-only] [--counts] [--ci]
 //                     [--narrow]
@@ -8,9 +9,12 @@
 // --narrow: walk one ray at a time where the processor could walk four (IntegrationConfig's
 // wide_walk off), to measure what the wide walk is worth.
 // --counts: also DDA steps and unique voxels per scan (for callgrind's instructions per step).
-// --ci: a short run (the first 10 BALM and 3 KITTI 00 scans at 0.2 m) that also exits 1 when a
+// --ci: a short run (a few BALM and KITTI 00 scans at 0.2 and 0.1 m) that also exits 1 when a
 // row's speed-up falls below the documented short-run value / 2.5 or its memory ratio to OctoMap
-// rises above the documented one (memory is deterministic). CTest runs it (label `bench`).
+// rises above the documented one (memory is deterministic). CTest runs it (BenchIntegrationCi,
+// label `bench`). The full run, by hand, holds its rows the same way and their two-thread
+// ratios too (kDocumented); a run with other --scans or --voxel values holds voxels only.
+// Missing real data is never a pass: exit 77 (CTest: skipped), 1 under STRATA_REQUIRE_DATA=1.
 //
 // OctoMap is compiled here without OpenMP, so it runs on one thread, as it does by default.
 #include <tbb/global_control.h>
@@ -49,15 +53,29 @@ struct Run {
     double unique_voxels = 0.0;  // per scan: voxels of the scan's update
 };
 
-// Short-run floors (--ci), from docs/bench.md's "CI rows": speed-up / 2.5, memory ratio as is.
-struct CiFloor {
+// A row of docs/bench.md and what it holds: the speed-up (and, by hand, the two-thread ratio)
+// at the documented value / kSlack, the memory ratio to OctoMap at the documented one
+// (deterministic). The two-thread ratio is not judged in CI: beside other tests on two cores
+// two threads measure the neighbours (0.46-0.79x at 0.2 m under a load of 8, against 1.6-1.9x
+// quiet).
+struct Documented {
     const char* dataset;
-    double min_speedup;
-    double max_memory_ratio;
+    double voxel;
+    size_t scans;
+    bool ci;  // a row of the short run
+    double speedup, two_threads, memory_ratio;
 };
-// Measured 2026-12-02 (issue 19, load average 10-12 from other builds; three runs gave BALM
-// 5.2-11.6x, KITTI 00 12.6-16.0x): BALM 11.0x, 1.18; KITTI 00 14.4x, 1.14.
-constexpr CiFloor kCiFloors[] = {{"balm", 12.5 / 2.5, 1.19}, {"kitti00", 16.0 / 2.5, 1.15}};
+constexpr double kSlack = 2.5;
+constexpr int kCiRepeats = 3;  // strata's timed runs in the short run: the fastest counts
+// Short run, 0.2 m: 2026-12-04 on 82bc77e, quiet. Short run, 0.1 m (issue 19's 0.1 m speed-up and
+// memory on fewer scans: OctoMap takes 1.3 s (BALM) and 3 s (KITTI) a scan there): medians of
+// six runs on 2026-12-05 under a load of 7-8 from other builds (two threads not measured: 0).
+// Full run: 2026-12-04 on 82bc77e, quiet (docs/bench.md's first table).
+constexpr Documented kDocumented[] = {
+    {"balm", 0.2, 10, true, 12.5, 1.61, 1.19},    {"kitti00", 0.2, 3, true, 16.0, 1.75, 1.15},
+    {"balm", 0.1, 3, true, 11.8, 0.0, 0.76},      {"kitti00", 0.1, 1, true, 8.7, 0.0, 0.76},
+    {"balm", 0.2, 89, false, 13.7, 1.89, 1.12},   {"balm", 0.1, 89, false, 42.9, 1.61, 0.68},
+    {"kitti00", 0.2, 6, false, 17.9, 1.63, 1.06}, {"kitti00", 0.1, 6, false, 32.1, 1.49, 0.53}};
 
 std::vector<WorldScan> LoadScans(const fs::path& dir, size_t max_scans, size_t& n_points) {
     std::vector<WorldScan> scans;
@@ -182,6 +200,18 @@ Run TimeInChild(const fs::path& data, const char* dataset, const std::string& en
     return run;
 }
 
+// The fastest of `repeats` timed runs in children: another process on a shared machine only
+// ever slows a run, so the fastest is the one least disturbed.
+Run FastestInChild(const fs::path& data, const char* dataset, const std::string& engine,
+                   double voxel, size_t scans, bool wide, int repeats) {
+    Run best = TimeInChild(data, dataset, engine, voxel, scans, wide);
+    for (int i = 1; i < repeats; ++i) {
+        const Run run = TimeInChild(data, dataset, engine, voxel, scans, wide);
+        if (run.ms_per_scan < best.ms_per_scan) best = run;
+    }
+    return best;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -221,98 +251,126 @@ int main(int argc, char** argv) {
         std::printf("%.6f %.6f\n", run.ms_per_scan, run.mem_mb);
         return 0;
     }
-    if (voxels.empty()) voxels = ci ? std::vector<double>{0.2} : std::vector<double>{0.2, 0.1};
+    if (voxels.empty()) voxels = {0.2, 0.1};
     std::printf(
         "| dataset | voxel m | scans | pts/scan | OctoMap ms/scan | strata 1T ms/scan | "
         "speed-up 1T | strata 2T ms/scan | 2T vs 1T | strata 1T Mpts/s | OctoMap MB | "
         "strata MB | Jaccard occ | Jaccard free | voxels differing |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    // The rows: every dataset at every voxel size, or the short run's.
+    std::vector<Documented> rows;
+    for (const Documented& d : kDocumented) {
+        if (ci && d.ci) rows.push_back(d);
+    }
+    if (!ci) {
+        for (const char* name : {"balm", "kitti00"}) {
+            for (const double voxel : voxels)
+                rows.push_back({name, voxel, max_scans, false, 0, 0, 0});
+        }
+    }
     int failures = 0;
-    for (const char* name : {"balm", "kitti00"}) {
+    fs::path missing;
+    for (const Documented& row : rows) {
+        const char* name = row.dataset;
+        const double voxel = row.voxel;
         const fs::path dir = data / name;
         if (!fs::exists(dir / "velodyne")) {
-            std::fprintf(stderr, "skipping %s: not found under %s\n", name, data.c_str());
+            missing = dir;
+            std::fprintf(stderr, "%s: not found under %s\n", name, data.c_str());
             continue;
         }
         size_t n_points = 0;
-        const size_t n = ci ? (std::string(name) == "balm" ? 10 : 3) : max_scans;
+        const size_t n = row.scans;
         const auto scans = LoadScans(dir, n, n_points);
-        for (const double voxel : voxels) {
-            // Times from processes of their own (TimeAlone); the maps compared and their
-            // memory (deterministic) from this one.
-            octomap::OcTree tree(voxel);
-            auto map = strata::core::VoxelMap::Create(voxel);
-            Run one = RunStrata(scans, 1, wide, map);
-            Run octo, two = one;
-            if (with_octomap) {
-                octo = RunOctomap(scans, tree);
-                const Run octo_alone = TimeInChild(data, name, "octomap", voxel, n, wide);
-                const Run one_alone = TimeInChild(data, name, "1", voxel, n, wide);
-                two = TimeInChild(data, name, "2", voxel, n, wide);
-                octo.ms_per_scan = octo_alone.ms_per_scan;
-                one.ms_per_scan = one_alone.ms_per_scan;
-            }
-            const double pts_per_scan = static_cast<double>(n_points) / scans.size();
-            const double speedup = octo.ms_per_scan / one.ms_per_scan;
-            double jaccard_occ = 0.0, jaccard_free = 0.0;
-            size_t differing = 0;
-            if (with_octomap) {
-                const auto ours = strata::testing::StrataVoxelSets(map);
-                const auto theirs = strata::testing::OctomapVoxelSets(tree);
-                jaccard_occ = strata::testing::Jaccard(ours.occupied, theirs.occupied);
-                jaccard_free = strata::testing::Jaccard(ours.free, theirs.free);
-                differing =
-                    strata::testing::CompareWithOctomap(map, tree, kLogOddsTolerance).total();
-            }
+        // Times from processes of their own (TimeAlone); the maps compared and their
+        // memory (deterministic) from this one.
+        octomap::OcTree tree(voxel);
+        auto map = strata::core::VoxelMap::Create(voxel);
+        Run one = RunStrata(scans, 1, wide, map);
+        Run octo, two = one;
+        if (with_octomap) {
+            octo = RunOctomap(scans, tree);
+            // The short run keeps OctoMap's time from this process, where it runs after strata
+            // (1-4 % slower, TimeAlone), well inside kSlack: a second OctoMap run in a child
+            // would cost CI as much again (1.3-3 s a scan at 0.1 m). strata's runs are short
+            // (a few scans), so it takes the fastest of kCiRepeats, the machine being shared.
+            if (!ci)
+                octo.ms_per_scan = TimeInChild(data, name, "octomap", voxel, n, wide).ms_per_scan;
+            const int repeats = ci ? kCiRepeats : 1;
+            one.ms_per_scan = FastestInChild(data, name, "1", voxel, n, wide, repeats).ms_per_scan;
+            two = FastestInChild(data, name, "2", voxel, n, wide, repeats);
+        }
+        const double pts_per_scan = static_cast<double>(n_points) / scans.size();
+        const double speedup = octo.ms_per_scan / one.ms_per_scan;
+        double jaccard_occ = 0.0, jaccard_free = 0.0;
+        size_t differing = 0;
+        if (with_octomap) {
+            const auto ours = strata::testing::StrataVoxelSets(map);
+            const auto theirs = strata::testing::OctomapVoxelSets(tree);
+            jaccard_occ = strata::testing::Jaccard(ours.occupied, theirs.occupied);
+            jaccard_free = strata::testing::Jaccard(ours.free, theirs.free);
+            differing = strata::testing::CompareWithOctomap(map, tree, kLogOddsTolerance).total();
+        }
+        std::printf(
+            "| %s | %.2f | %zu | %.0f | %.1f | %.1f | %.1fx | %.1f | %.2fx | %.2f | %.1f "
+            "| %.1f | %.4f | %.4f | %zu |\n",
+            name, voxel, scans.size(), pts_per_scan, octo.ms_per_scan, one.ms_per_scan, speedup,
+            two.ms_per_scan, one.ms_per_scan / two.ms_per_scan,
+            pts_per_scan / one.ms_per_scan / 1e3, octo.mem_mb, one.mem_mb, jaccard_occ,
+            jaccard_free, differing);
+        if (counts) {
+            double steps = 0.0;
+            for (const auto& s : scans) steps += DdaSteps(s, voxel);
+            steps /= scans.size();
             std::printf(
-                "| %s | %.2f | %zu | %.0f | %.1f | %.1f | %.1fx | %.1f | %.2fx | %.2f | %.1f "
-                "| %.1f | %.4f | %.4f | %zu |\n",
-                name, voxel, scans.size(), pts_per_scan, octo.ms_per_scan, one.ms_per_scan, speedup,
-                two.ms_per_scan, one.ms_per_scan / two.ms_per_scan,
-                pts_per_scan / one.ms_per_scan / 1e3, octo.mem_mb, one.mem_mb, jaccard_occ,
-                jaccard_free, differing);
-            if (counts) {
-                double steps = 0.0;
-                for (const auto& s : scans) steps += DdaSteps(s, voxel);
-                steps /= scans.size();
-                std::printf(
-                    "  counts: %.0f DDA steps/scan, %.0f unique voxels/scan, %.1f steps per "
-                    "unique voxel\n",
-                    steps, one.unique_voxels, steps / one.unique_voxels);
-                for (const double near_m : {2.0, 5.0, 10.0}) {
-                    double near = 0.0;
-                    for (const auto& s : scans) near += DdaSteps(s, voxel, near_m);
-                    std::printf("  steps within %.0f m of the sensor: %.1f %%\n", near_m,
-                                100.0 * near / scans.size() / steps);
-                }
-                std::printf("  uniform occupancy leaves: %zu\n", UniformLeaves(map));
-                for (const auto& g : map.Grids()) {
-                    std::printf("  grid %s: %.2f MB, %zu leaves, %zu active voxels\n",
-                                g->getName().c_str(), static_cast<double>(g->memUsage()) / 1e6,
-                                static_cast<size_t>(g->baseTreePtr()->leafCount()),
-                                static_cast<size_t>(g->activeVoxelCount()));
-                }
+                "  counts: %.0f DDA steps/scan, %.0f unique voxels/scan, %.1f steps per "
+                "unique voxel\n",
+                steps, one.unique_voxels, steps / one.unique_voxels);
+            for (const double near_m : {2.0, 5.0, 10.0}) {
+                double near = 0.0;
+                for (const auto& s : scans) near += DdaSteps(s, voxel, near_m);
+                std::printf("  steps within %.0f m of the sensor: %.1f %%\n", near_m,
+                            100.0 * near / scans.size() / steps);
             }
-            std::fflush(stdout);
-            if (differing > 0) {
-                std::fprintf(stderr, "FAIL %s %.2f: %zu voxels differ from OctoMap\n", name, voxel,
-                             differing);
-                ++failures;
-            }
-            for (const CiFloor& f : kCiFloors) {
-                if (!ci || std::string(f.dataset) != name) continue;
-                if (speedup < f.min_speedup) {
-                    std::fprintf(stderr, "FAIL %s: speed-up %.1fx below the floor %.1fx\n", name,
-                                 speedup, f.min_speedup);
-                    ++failures;
-                }
-                if (one.mem_mb > f.max_memory_ratio * octo.mem_mb) {
-                    std::fprintf(stderr, "FAIL %s: memory %.1f MB above %.2f x OctoMap's %.1f MB\n",
-                                 name, one.mem_mb, f.max_memory_ratio, octo.mem_mb);
-                    ++failures;
-                }
+            std::printf("  uniform occupancy leaves: %zu\n", UniformLeaves(map));
+            for (const auto& g : map.Grids()) {
+                std::printf("  grid %s: %.2f MB, %zu leaves, %zu active voxels\n",
+                            g->getName().c_str(), static_cast<double>(g->memUsage()) / 1e6,
+                            static_cast<size_t>(g->baseTreePtr()->leafCount()),
+                            static_cast<size_t>(g->activeVoxelCount()));
             }
         }
+        std::fflush(stdout);
+        if (differing > 0) {
+            std::fprintf(stderr, "FAIL %s %.2f: %zu voxels differ from OctoMap\n", name, voxel,
+                         differing);
+            ++failures;
+        }
+        // The documented row this one repeats, if any (same data, voxel, scans and kind).
+        const Documented* doc = nullptr;
+        for (const Documented& d : kDocumented) {
+            if (d.ci == ci && std::string(d.dataset) == name && d.voxel == voxel &&
+                d.scans == scans.size()) {
+                doc = &d;
+            }
+        }
+        if (doc == nullptr || !with_octomap) continue;
+        const double two_threads = one.ms_per_scan / two.ms_per_scan;
+        if (speedup < doc->speedup / kSlack) {
+            std::fprintf(stderr, "FAIL %s %.2f: speed-up %.1fx below the floor %.1fx\n", name,
+                         voxel, speedup, doc->speedup / kSlack);
+            ++failures;
+        }
+        if (!ci && two_threads < doc->two_threads / kSlack) {
+            std::fprintf(stderr, "FAIL %s %.2f: two threads %.2fx one, below the floor %.2fx\n",
+                         name, voxel, two_threads, doc->two_threads / kSlack);
+            ++failures;
+        }
+        if (one.mem_mb > doc->memory_ratio * octo.mem_mb) {
+            std::fprintf(stderr, "FAIL %s %.2f: memory %.1f MB above %.2f x OctoMap's %.1f MB\n",
+                         name, voxel, one.mem_mb, doc->memory_ratio, octo.mem_mb);
+            ++failures;
+        }
     }
-    return failures == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return strata::bench::ExitStatus("bench_integration", failures > 0, missing);
 }

@@ -2,11 +2,13 @@
 // for a scan against a map (KITTI 00), a session against a map (BALM halves) and scan-to-slice
 // localization in the simulated building; then strata against the raw-point ICP on every real
 // pair (RegistrationPairs.cpp). Prints two markdown tables; exits 1 when a pair misses the
-// 0.05 deg target, or a row of the first table errs by more than 2.5x what docs/registration.md
-// measured (CTest: bench_registration.AccuracyTargets, label bench). Without ../shared/data the
-// real-data rows are left out, which STRATA_REQUIRE_DATA=1 (CI) turns into a failure.
+// 0.05 deg target, a row of the first table errs by more than 2.5x what docs/registration.md
+// measured, or (unless --accuracy-only) localization takes more than issue 8's 20 ms a scan on
+// one core. CTest runs it with --accuracy-only (bench_registration.AccuracyTargets, label bench):
+// times are measured by hand. Without ../shared/data the real-data rows are left out and the
+// program exits 77 (CTest: skipped), 1 under STRATA_REQUIRE_DATA=1 (CI).
 //
-//   bench_registration [DATA_DIR] [--repeat N]
+//   bench_registration [DATA_DIR] [--repeat N] [--accuracy-only]
 //
 // Maps are integrated in memory first (all cores, outside any timing); the registrations run on
 // one thread (TBB limited to 1 for the timed part).
@@ -14,6 +16,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -63,13 +66,16 @@ void Print(const Row& r) {
                 r.note.c_str());
 }
 
-// The errors docs/registration.md measured for the rows of the first table (2026-12-02), held at
-// kSlack times; the runs are deterministic on one thread.
+// The errors docs/registration.md measured for the rows of the first table (2026-12-02; the
+// localization's rotation 2026-12-05), held at kSlack times; the runs are deterministic on one
+// thread.
 constexpr double kSlack = 2.5;
 struct Documented {
     double error_m, error_deg;
 };
-constexpr Documented kKitti{0.003, 0.008}, kBalm{0.003, 0.014}, kLocalization{0.008, 0.0};
+constexpr Documented kKitti{0.003, 0.008}, kBalm{0.003, 0.014}, kLocalization{0.008, 0.034};
+// Issue 8's target for localization: at most 20 ms a scan on one core (median over the scans).
+constexpr double kMaxLocalizationMs = 20.0;
 
 // Prints the row; returns false (and says why) when it errs by more than kSlack x `doc` or was
 // refused.
@@ -83,15 +89,6 @@ bool PrintHeld(const Row& r, const Documented& doc) {
                      r.name.c_str(), r.error_m, r.error_deg, doc.error_m, doc.error_deg);
     }
     return held;
-}
-
-// True when real data is required (CI) but `file` is missing; says so.
-bool MissingRequired(const fs::path& file) {
-    const char* require = std::getenv("STRATA_REQUIRE_DATA");
-    if (fs::exists(file) || require == nullptr || std::string(require) != "1") return false;
-    std::fprintf(stderr, "bench_registration: STRATA_REQUIRE_DATA=1 and %s is missing\n",
-                 file.c_str());
-    return true;
 }
 
 // `source` to `map_points` from `guess`, `repeat` times on one core: median times, last result.
@@ -119,8 +116,9 @@ Row Time(const std::string& name, const std::vector<Eigen::Vector3d>& map_points
             r.converged ? "accepted" : "refused: " + r.refusal};
 }
 
-// Prints the first table; returns the number of rows that miss their documented errors.
-int Run(const fs::path& data, int repeat) {
+// Prints the first table; returns the number of rows that miss their documented errors (or,
+// with `times`, the localization time); `missing` gets a real-data file that was not found.
+int Run(const fs::path& data, int repeat, bool times, fs::path& missing) {
     int misses = 0;
     std::printf(
         "| case | map points | source points | surface ms | registration ms (median of %d, 1 "
@@ -145,7 +143,7 @@ int Run(const fs::path& data, int repeat) {
                             points, k.scans[5], off * optimum, optimum, scan_config, repeat),
                        kKitti);
     } else {
-        misses += MissingRequired(data / "kitti00/poses_sptam.txt");
+        missing = data / "kitti00/poses_sptam.txt";
     }
     if (fs::exists(data / "balm/poses.txt")) {
         const auto scans = strata::bench::LoadKittiScans(data / "balm");
@@ -166,7 +164,7 @@ int Run(const fs::path& data, int repeat) {
                             cloud, off * move.inverse(), base * move.inverse(), config, repeat),
                        kBalm);
     } else {
-        misses += MissingRequired(data / "balm/poses.txt");
+        missing = data / "balm/poses.txt";
     }
     // Localization in the simulated building's floor-1 slice, scan after scan.
     const fs::path dir =
@@ -196,7 +194,7 @@ int Run(const fs::path& data, int repeat) {
     Row row;
     row.name = "building floor 1: scan -> slice of the stacked map (0.1 m), from the previous pose";
     std::vector<double> ms;
-    double sum2 = 0.0;
+    double sum2 = 0.0, sum2_deg = 0.0;
     {
         const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
         const reg::Surface s = reg::Surface::FromPoints(points, loc.surface);
@@ -206,6 +204,7 @@ int Run(const fs::path& data, int repeat) {
             const auto r = reg::RegisterPoints(s, scan.points, guess, loc);
             ms.push_back(r.time_ms);
             sum2 += (r.T_map_source.translation() - truth.translation()).squaredNorm();
+            sum2_deg += std::pow(reg::AngleDeg(truth.inverse() * r.T_map_source), 2);
             guess = r.T_map_source;
             row.source_points = r.source_points;
         }
@@ -213,8 +212,14 @@ int Run(const fs::path& data, int repeat) {
     row.map_points = points.size();
     row.register_ms = Median(ms);
     row.error_m = std::sqrt(sum2 / double(ms.size()));
-    row.note = "error = RMSE over " + std::to_string(ms.size()) + " scans; ms = median per scan";
+    row.error_deg = std::sqrt(sum2_deg / double(ms.size()));
+    row.note = "errors = RMSE over " + std::to_string(ms.size()) + " scans; ms = median per scan";
     misses += !PrintHeld(row, kLocalization);
+    if (times && row.register_ms > kMaxLocalizationMs) {
+        std::fprintf(stderr, "bench_registration: localization %.1f ms a scan, target <= %.0f ms\n",
+                     row.register_ms, kMaxLocalizationMs);
+        ++misses;
+    }
     std::error_code ignored;
     fs::remove_all(dir, ignored);
     return misses;
@@ -224,15 +229,26 @@ int Run(const fs::path& data, int repeat) {
 
 int main(int argc, char** argv) {
     try {
-        const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
-        const int row_misses = Run(args.data, args.repeat);
+        std::vector<char*> rest;
+        bool times = true;
+        for (int i = 0; i < argc; ++i) {
+            if (std::string(argv[i]) == "--accuracy-only") {
+                times = false;
+            } else {
+                rest.push_back(argv[i]);
+            }
+        }
+        const auto args = strata::bench::ParseRepeatArgs(static_cast<int>(rest.size()), rest.data(),
+                                                         STRATA_DATA_DIR);
+        fs::path missing;
+        const int row_misses = Run(args.data, args.repeat, times, missing);
         std::printf("\n");
         const int misses = strata::bench::PrintRegistrationPairs(args.data, args.repeat);
         if (misses > 0) {
             std::fprintf(stderr, "bench_registration: %d pair(s) miss the 0.05 deg target\n",
                          misses);
         }
-        return row_misses + misses > 0 ? 1 : 0;
+        return strata::bench::ExitStatus("bench_registration", row_misses + misses > 0, missing);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_registration: %s\n", e.what());
         return 1;

@@ -2,7 +2,8 @@
 // 64 m tiles, at every level of detail: its steps (the tile read and verified, its level-0 cells,
 // coarsened and encoded) and the whole answer over HTTP, cold (a server without caches) and as
 // `strata view` serves it. Prints a markdown table and exits non-zero when the median answer as
-// served misses its target (50 ms) at any level.
+// served misses its target (50 ms) at any level, 77 when BALM is missing (1 under
+// STRATA_REQUIRE_DATA=1). Run by hand (bench/run_benchmarks.sh), not in CI.
 //
 //   bench_viewer [DATA_DIR] [--repeat N] [--keep DIR]
 //
@@ -78,10 +79,7 @@ int main(int argc, char** argv) {
     const strata::bench::RepeatArgs args =
         strata::bench::ParseRepeatArgs(static_cast<int>(rest.size()), rest.data(), STRATA_DATA_DIR);
     const fs::path balm = args.data / "balm";
-    if (!fs::is_directory(balm)) {
-        std::printf("bench_viewer: %s not found, skipped\n", balm.c_str());
-        return 0;
-    }
+    if (!fs::is_directory(balm)) return strata::bench::MissingDataStatus("bench_viewer", balm);
     const auto scans = strata::bench::LoadKittiScans(balm);
     const fs::path map = strata::test::TempPath("bench_viewer_balm01");
     BuildMap(scans, map, 0.1, 1);

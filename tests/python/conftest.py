@@ -1,5 +1,7 @@
 """Shared fixtures of the Python module's tests: small simulated scans, the strata program,
-the source tree and the real data (tests that need it skip with a message when it is absent)."""
+the source tree and the real data (tests that need it skip with a message when it is absent;
+under STRATA_REQUIRE_DATA=1, as CI sets it, every skip is a failure: pytest runs as one CTest
+test, `python_pytest`, which passes whatever pytest skipped, so nothing else would see it)."""
 import hashlib
 import os
 import pathlib
@@ -15,6 +17,42 @@ SOURCE_DIR = pathlib.Path(os.environ.get("STRATA_SOURCE_DIR",
 DATA_DIR = pathlib.Path(os.environ.get("STRATA_DATA_DIR", SOURCE_DIR.parent / "shared" / "data"))
 STRATA = os.environ.get("STRATA_BINARY", str(SOURCE_DIR / "build" / "tools" / "strata" / "strata"))
 STREET = SOURCE_DIR / "datasets" / "scenes" / "street.json"
+# Missing real data fails instead of skipping (tests/support/RealData.hpp does the same in C++).
+REQUIRE_DATA = os.environ.get("STRATA_REQUIRE_DATA") == "1"
+
+
+def skip_without_data(path):
+    """Skips the calling test when the real data at `path` is absent: a failure under
+    STRATA_REQUIRE_DATA=1."""
+    if pathlib.Path(path).exists():
+        return
+    if REQUIRE_DATA:
+        pytest.fail(f"real data not found: {path} (STRATA_REQUIRE_DATA=1; "
+                    "see ../shared/data/README.md)")
+    pytest.skip(f"real data not found: {path} (see ../shared/data/README.md)")
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Under STRATA_REQUIRE_DATA=1 any skip fails its test, whatever called pytest.skip: CI
+    must not pass on a smaller suite."""
+    outcome = yield
+    report = outcome.get_result()
+    if REQUIRE_DATA and report.skipped and not hasattr(report, "wasxfail"):
+        reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else report.longrepr
+        report.outcome = "failed"
+        report.longrepr = f"skipped under STRATA_REQUIRE_DATA=1, which allows no skip: {reason}"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_make_collect_report(collector):
+    """The same for a whole module skipped while it is collected."""
+    outcome = yield
+    report = outcome.get_result()
+    if REQUIRE_DATA and report.skipped:
+        reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else report.longrepr
+        report.outcome = "failed"
+        report.longrepr = f"skipped under STRATA_REQUIRE_DATA=1, which allows no skip: {reason}"
 
 
 def run_strata(*args, cwd=None) -> subprocess.CompletedProcess:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import strata
-from conftest import DATA_DIR, kitti_scans, run_strata
+from conftest import DATA_DIR, kitti_scans, run_strata, skip_without_data
 
 EVERYWHERE = ([-1e4, -1e4, -1e4], [1e4, 1e4, 1e4])
 
@@ -34,8 +34,7 @@ def test_a_simulated_street_from_numpy_equals_strata_integrate(tmp_path, street_
 
 def test_kitti_00_from_numpy_equals_strata_integrate(tmp_path):
     sequence = DATA_DIR / "kitti00"
-    if not (sequence / "velodyne").is_dir():
-        pytest.skip(f"real data absent: {sequence} (see ../shared/data/README)")
+    skip_without_data(sequence / "velodyne")
     ours = integrate_from_numpy(tmp_path / "ours", sequence, frames=range(2))
     run_strata("integrate", tmp_path / "theirs", "--kitti", sequence, "--frames", "0:2")
     with strata.Map.open(tmp_path / "theirs", read_only=True) as theirs:
