@@ -64,10 +64,13 @@ inline std::vector<core::Scan> LoadKittiScans(
     return scans;
 }
 
-/// `PROGRAM [DATA_DIR] [--repeat N]`: the arguments of the benchmarks that repeat a measurement.
+/// `PROGRAM [DATA_DIR] [--repeat N] [--accuracy-only]`: the arguments of the benchmarks that
+/// repeat a measurement. --accuracy-only (the CTest entries of those that have accuracy targets):
+/// the accuracy checks without the timed runs.
 struct RepeatArgs {
     std::filesystem::path data;
     int repeat = 5;
+    bool accuracy_only = false;
 };
 inline RepeatArgs ParseRepeatArgs(int argc, char** argv, const std::filesystem::path& data) {
     RepeatArgs args{data, 5};
@@ -75,6 +78,8 @@ inline RepeatArgs ParseRepeatArgs(int argc, char** argv, const std::filesystem::
         const std::string arg = argv[i];
         if (arg == "--repeat" && i + 1 < argc) {
             args.repeat = std::max(1, std::atoi(argv[++i]));
+        } else if (arg == "--accuracy-only") {
+            args.accuracy_only = true;
         } else {
             args.data = arg;
         }

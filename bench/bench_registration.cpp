@@ -229,19 +229,9 @@ int Run(const fs::path& data, int repeat, bool times, fs::path& missing) {
 
 int main(int argc, char** argv) {
     try {
-        std::vector<char*> rest;
-        bool times = true;
-        for (int i = 0; i < argc; ++i) {
-            if (std::string(argv[i]) == "--accuracy-only") {
-                times = false;
-            } else {
-                rest.push_back(argv[i]);
-            }
-        }
-        const auto args = strata::bench::ParseRepeatArgs(static_cast<int>(rest.size()), rest.data(),
-                                                         STRATA_DATA_DIR);
+        const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
         fs::path missing;
-        const int row_misses = Run(args.data, args.repeat, times, missing);
+        const int row_misses = Run(args.data, args.repeat, !args.accuracy_only, missing);
         std::printf("\n");
         const int misses = strata::bench::PrintRegistrationPairs(args.data, args.repeat);
         if (misses > 0) {

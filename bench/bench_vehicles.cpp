@@ -204,19 +204,9 @@ fs::path Speed(const fs::path& data, int repeat) {
 
 int main(int argc, char** argv) {
     try {
-        std::vector<char*> rest;
-        bool accuracy_only = false;
-        for (int i = 0; i < argc; ++i) {
-            if (std::string(argv[i]) == "--accuracy-only") {
-                accuracy_only = true;
-            } else {
-                rest.push_back(argv[i]);
-            }
-        }
-        const auto args = strata::bench::ParseRepeatArgs(static_cast<int>(rest.size()), rest.data(),
-                                                         STRATA_DATA_DIR);
+        const auto args = strata::bench::ParseRepeatArgs(argc, argv, STRATA_DATA_DIR);
         const bool met = Accuracy();
-        const fs::path missing = accuracy_only ? fs::path() : Speed(args.data, args.repeat);
+        const fs::path missing = args.accuracy_only ? fs::path() : Speed(args.data, args.repeat);
         return strata::bench::ExitStatus("bench_vehicles", !met, missing);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_vehicles: %s\n", e.what());
