@@ -14,6 +14,7 @@
 #include <limits>
 #include <random>
 
+#include "Sanitizer.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
 
@@ -32,12 +33,9 @@ bool Full() {
     return env && *env == '1';
 }
 
-// Set by tools/sanitize.sh (address or thread). Instrumented code is 5-15 times slower, and its
-// shadow memory and redzones make the process's RSS say nothing about the integrator's memory.
-bool UnderSanitizer() {
-    const char* env = std::getenv("STRATA_SANITIZER");
-    return env && *env;
-}
+// Instrumented code is 5-15 times slower, and its shadow memory and redzones make the process's
+// RSS say nothing about the integrator's memory.
+using strata::testing::UnderSanitizer;
 
 // n points on a sphere of radius r around the sensor, seeded.
 core::Scan SphereScan(size_t n, double r, uint64_t seed) {

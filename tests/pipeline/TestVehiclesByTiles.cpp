@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <vector>
 
 #include "MapDiff.hpp"
 #include "PipelineTestUtil.hpp"
+#include "Sanitizer.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/Vehicles.hpp"
 
@@ -104,8 +106,11 @@ TEST(VehiclesByTiles, TheGeometricDetectorsLongObjectsAreJoinedAcrossWindows) {
 // outcome stores, for either source (the geometric detector's vehicles at the map's edge refill
 // ground where no tile was stored).
 TEST(VehiclesByTiles, StoredTileByTileTheCleanedMapIsTheWholeMapsVoxelForVoxel) {
-    for (const vehicles::VehicleSource source :
-         {vehicles::VehicleSource::kAuto, vehicles::VehicleSource::kGeometric}) {
+    // Under a sanitizer the geometric source alone (its edge refill is the case of its own):
+    // the labelled source takes the same calls, at 90 s of ASan time (docs/reliability.md).
+    std::vector<vehicles::VehicleSource> sources = {vehicles::VehicleSource::kGeometric};
+    if (!strata::testing::UnderSanitizer()) sources.push_back(vehicles::VehicleSource::kAuto);
+    for (const vehicles::VehicleSource source : sources) {
         SCOPED_TRACE(vehicles::SourceName(source));
         const fs::path whole_dir = Temp("vehicles_tiles_whole"),
                        tiled_dir = Temp("vehicles_tiles_cut");

@@ -15,6 +15,7 @@
 
 #include "CliTestUtil.hpp"
 #include "MapDiff.hpp"
+#include "Sanitizer.hpp"
 #include "strata/store/MapStore.hpp"
 
 namespace strata::tools::test {
@@ -32,7 +33,7 @@ Result Mpirun(int ranks, const std::string& args) {
 // and the two-rank run repeats the paths the three-rank run takes (hand-over, joining, rank 0's
 // commit) at a minute of CI time per test (docs/reliability.md, "Sanitizers").
 std::vector<int> RankCounts() {
-    if (std::getenv("STRATA_SANITIZER") != nullptr) return {3};
+    if (strata::testing::UnderSanitizer()) return {3};
     return {2, 3};
 }
 
