@@ -16,6 +16,7 @@ find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json 3 CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
+pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)  # ROS 1 bags' lz4 chunks
 # Open MPI (libopenmpi-dev) for `mpirun strata ...`; without it strata runs as one process.
 find_package(MPI COMPONENTS CXX QUIET)
 if(MPI_CXX_FOUND)

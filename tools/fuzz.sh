@@ -11,12 +11,12 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-20}
 build="$root/build-fuzz"
-targets=(${STRATA_FUZZ_TARGETS:-kitti bin pcd ply las text text_bz2 poses scene map catalog})
+targets=(${STRATA_FUZZ_TARGETS:-kitti bin pcd ply las text text_bz2 poses scene map catalog ros1bag})
 
 # Largest input per target: a few records beyond the seeds, small enough to mutate quickly.
 declare -A max_len=([kitti]=1024 [bin]=1024 [pcd]=4096 [ply]=4096 [las]=4096 [text]=2048
                     [text_bz2]=2048 [poses]=2048 [scene]=8192 [map]=81920
-                    [catalog]=131072)
+                    [catalog]=131072 [ros1bag]=16384)
 
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (tools/setup.sh installs it)" >&2; exit 1; }
 start=$(date +%s)
@@ -30,6 +30,13 @@ echo "fuzz.sh: build took $(($(date +%s) - start)) s"
 
 rm -rf "$build/seeds"
 "$build/tests/fuzz/fuzz_make_corpus" "$build/seeds"
+# Seed bags by an independent writer, Debian's python3-rosbag (tools/setup.sh installs it), in
+# each compression, with per-point times and poses denser than the sweeps.
+mkdir -p "$build/seeds/ros1bag"
+for c in none bz2 lz4; do
+  /usr/bin/python3 "$root/tests/recordings/write_ros1_bag.py" "$build/seeds/_ros1bag_seq" \
+    "$build/seeds/ros1bag/$c.bag" --compression "$c" --chunk-kb 1 --point-time t --tf-rate 3
+done
 mkdir -p "$build/corpus" "$build/artifacts" "$build/logs"
 
 # Leak checking is off: OpenVDB and TBB keep process-lifetime allocations that are not bugs.

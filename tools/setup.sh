@@ -34,6 +34,10 @@ packages=(
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, docs/python.md)
   python3-matplotlib                      # docs/python.md's plotting example (tested)
   groff-base                              # the install test reads the man pages (groff)
+  liblz4-dev                              # ROS 1 bags' lz4 chunks (src/recordings/)
+  # An independent writer of the test recordings: ROS 1 bags by rosbag (tests/recordings/).
+  python3-rosbag python3-roslz4 python3-sensor-msgs python3-tf2-msgs python3-nav-msgs
+  python3-geometry-msgs
 )
 
 missing=()

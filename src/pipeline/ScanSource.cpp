@@ -1,47 +1,28 @@
 #include "strata/pipeline/ScanSource.hpp"
 
-#include <stdexcept>
-
 #include "strata/core/Error.hpp"
+#include "strata/core/FrameRange.hpp"
 #include "strata/io/PoseFiles.hpp"
 
 namespace strata::pipeline {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-// "A:B", "A:", ":B" or "A" (one frame). Half-open, checked against the sequence length.
-std::pair<size_t, size_t> ParseFrames(const std::string& text, size_t n) {
-    if (text.empty()) return {0, n};
-    try {
-        const auto colon = text.find(':');
-        if (colon == std::string::npos) {
-            const size_t a = std::stoul(text);
-            if (a < n) return {a, a + 1};
-            throw std::out_of_range(text);
-        }
-        const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-        const size_t begin = a.empty() ? 0 : std::stoul(a);
-        const size_t end = b.empty() ? n : std::stoul(b);
-        if (begin < end && end <= n) return {begin, end};
-    } catch (const std::logic_error&) {
-    }
-    throw InvalidArgumentError("--frames '" + text +
-                               "': expected A:B with 0 <= A < B <= " + std::to_string(n));
-}
-
-}  // namespace
-
 void ScanSpec::Validate() const {
-    if (kitti.empty() == files.empty()) {
-        throw InvalidArgumentError("give exactly one of --kitti SEQ or --scans FILES...");
+    if (int{!kitti.empty()} + int{!files.empty()} + int{!bag.empty()} != 1) {
+        throw InvalidArgumentError(
+            "give exactly one of --kitti SEQ, --scans FILES... or --bag FILE");
     }
 }
 
 ScanSource ScanSource::Open(const ScanSpec& spec, const Eigen::Vector3d& origin) {
     spec.Validate();
     if (!spec.kitti.empty()) return Kitti(spec.kitti, spec.frames);
+    if (!spec.bag.empty()) {
+        recordings::RecordedScanOptions options = spec.recording;
+        options.frames = spec.frames;
+        return Recording(spec.bag, options);
+    }
     io::ReadOptions options;
     options.origin = origin;
     options.bin_fields = spec.bin_fields;
@@ -51,8 +32,16 @@ ScanSource ScanSource::Open(const ScanSpec& spec, const Eigen::Vector3d& origin)
 ScanSource ScanSource::Kitti(const fs::path& dir, const std::string& frames) {
     ScanSource s;
     s.kitti_ = io::OpenKittiSequence(dir);
-    const auto [begin, end] = ParseFrames(frames, s.kitti_->size());
+    const auto [begin, end] = core::ParseFrameRange(frames, s.kitti_->size());
     for (size_t i = begin; i < end; ++i) s.indices_.push_back(i);
+    return s;
+}
+
+ScanSource ScanSource::Recording(const fs::path& bag,
+                                 const recordings::RecordedScanOptions& options) {
+    ScanSource s;
+    s.recording_ = std::make_shared<const recordings::RecordedScans>(
+        recordings::RecordedScans::Open(bag, options));
     return s;
 }
 
@@ -75,6 +64,7 @@ ScanSource ScanSource::Files(std::vector<fs::path> files, const fs::path& poses,
 
 core::Scan ScanSource::Read(size_t i) const {
     if (kitti_) return io::ReadKittiScan(*kitti_, indices_.at(i));
+    if (recording_) return recording_->Read(i);
     core::Scan scan = io::ReadPointCloud(files_.at(i), options_);
     if (!poses_.empty()) scan.T_world_sensor = poses_[i];
     return scan;
@@ -82,6 +72,7 @@ core::Scan ScanSource::Read(size_t i) const {
 
 std::string ScanSource::Describe() const {
     if (kitti_) return kitti_->dir.string();
+    if (recording_) return recording_->info().path.string() + " " + recording_->points_topic();
     return files_.empty() ? std::string() : files_.front().string();
 }
 

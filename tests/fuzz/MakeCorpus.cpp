@@ -132,6 +132,16 @@ void WriteSeeds(const fs::path& out) {
     const std::string tile = fuzz::CreateSmallMap(map_dir);
     Seed(out, "map", "tile.vdb", Slurp(map_dir / tile));
     Seed(out, "catalog", "catalog.sqlite", Slurp(map_dir / "catalog.sqlite"));
+    // ROS 1 bags: two scans of eight points with their poses, a KITTI-layout folder that
+    // tools/fuzz.sh has python3-rosbag write as bags (tests/recordings/write_ros1_bag.py).
+    const fs::path seq = out / "_ros1bag_seq";
+    fs::create_directories(seq / "velodyne");
+    for (int k = 0; k < 2; ++k) {
+        std::vector<Eigen::Vector3d> points;
+        for (int i = 0; i < 8; ++i) points.emplace_back(1.0 + i, 0.5 * k - 0.25 * i, 0.1 * i);
+        io::WriteKittiBin(seq / "velodyne" / ("00000" + std::to_string(k) + ".bin"), points);
+    }
+    io::WriteKittiPoses(seq / "poses.txt", {Eigen::Isometry3d::Identity(), T});
     fs::remove_all(scratch);
 }
 

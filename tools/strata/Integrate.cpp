@@ -57,6 +57,10 @@ void PrintStart(const pipeline::IntegrationStart& s, const IntegrateArgs& args) 
               << (config.points_only ? ", points only" : "")
               << (config.keep_point_means ? "" : ", no point means") << ", threads "
               << (args.threads > 0 ? std::to_string(args.threads) : "all") << "\n";
+    if (const recordings::RecordedScans* r = s.source.recording()) {
+        std::cerr << "strata integrate: sweeps of " << r->points_topic() << " posed in "
+                  << r->fixed_frame() << ", " << r->deskew_note() << "\n";
+    }
 }
 
 void Run(const IntegrateArgs& args, const CLI::App& cmd) {
@@ -109,6 +113,7 @@ void RegisterIntegrate(CLI::App& app) {
         "  strata integrate garage.strata --scans a.pcd b.pcd --poses poses.txt\n"
         "  strata integrate tile.strata --scans autzen.las --points-only --voxel 1.0\n"
         "  strata integrate city.strata --kitti day2/ --align --init 3,-1,0,10\n"
+        "  strata integrate street.strata --bag drive.bag --points-topic /points_raw\n"
         "Each run adds one session; the map changes only once every scan is integrated.");
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     AddScanOptions(*cmd, args->scans);

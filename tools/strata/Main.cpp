@@ -84,6 +84,7 @@ int RunCommand(int argc, char** argv, const strata::pipeline::Ranks& ranks) {
     strata::tools::RegisterVehicles(app);
     strata::tools::RegisterRegister(app);
     strata::tools::RegisterFloors(app);
+    strata::tools::RegisterBag(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     strata::tools::RegisterView(app);

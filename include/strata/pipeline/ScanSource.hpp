@@ -1,8 +1,9 @@
 #pragma once
-// Scans to integrate or align: a KITTI sequence, or point-cloud files with an optional pose file.
-// `strata integrate`, `register` and `diff --to-kitti` read them alike.
+// Scans to integrate or align: a KITTI sequence, point-cloud files with an optional pose file, or
+// a robot recording. `strata integrate`, `register` and `diff --to-kitti` read them alike.
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,20 +11,26 @@
 #include "strata/core/Scan.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PointCloudReaders.hpp"
+#include "strata/recordings/RecordedScans.hpp"
 
 namespace strata::pipeline {
 
-/// @brief Where the scans are, as a command names them: a KITTI sequence (and a frame range), or
-/// files with an optional pose file. Exactly one of `kitti` and `files`.
+/// @brief Where the scans are, as a command names them: a KITTI sequence (and a frame range),
+/// files with an optional pose file, or a recording (and a range of its sweeps). Exactly one of
+/// `kitti`, `files` and `bag`.
 struct ScanSpec {
     std::filesystem::path kitti;  ///< KITTI / SemanticKITTI sequence folder
+    std::filesystem::path bag;    ///< a ROS 1 bag
     /// "A:B" (half-open, either side may be empty), "A" (one frame) or empty for all.
     std::string frames;
+    /// How the recording's sweeps are chosen and posed (its `frames` is the one above).
+    recordings::RecordedScanOptions recording;
     std::vector<std::filesystem::path> files;  ///< PCD, PLY, LAS, .bin or text (.bz2)
     std::filesystem::path poses;               ///< KITTI 3x4 or TUM, by index; empty: identity
     int bin_fields = 0;  ///< float32 values per point of raw .bin files; 0: from name or size
 
-    /// @brief Throws InvalidArgumentError unless exactly one of `kitti` and `files` is given.
+    /// @brief Throws InvalidArgumentError unless exactly one of `kitti`, `files` and `bag` is
+    /// given.
     void Validate() const;
 };
 
@@ -37,19 +44,26 @@ public:
     /// @brief A KITTI sequence; `frames` as ScanSpec::frames.
     [[nodiscard]] static ScanSource Kitti(const std::filesystem::path& dir,
                                           const std::string& frames);
+    /// @brief A recording's sweeps (RecordedScans).
+    [[nodiscard]] static ScanSource Recording(const std::filesystem::path& bag,
+                                              const recordings::RecordedScanOptions& options);
     /// @brief Point-cloud files; poses by index from `poses` (KITTI or TUM), identity when empty.
     [[nodiscard]] static ScanSource Files(std::vector<std::filesystem::path> files,
                                           const std::filesystem::path& poses,
                                           const io::ReadOptions& options);
 
-    [[nodiscard]] size_t size() const { return indices_.size(); }
+    [[nodiscard]] size_t size() const { return recording_ ? recording_->size() : indices_.size(); }
     /// @brief Scan `i` (0 <= i < size()) with its pose; reader errors name the file.
     [[nodiscard]] core::Scan Read(size_t i) const;
-    /// @brief The sequence folder, or the first file.
+    /// @brief The sequence folder, the first file, or the recording and its topic.
     [[nodiscard]] std::string Describe() const;
+    /// @brief The recording's sweeps, or nullptr for other sources (for what a command says
+    /// about their poses and deskewing).
+    [[nodiscard]] const recordings::RecordedScans* recording() const { return recording_.get(); }
 
 private:
     std::optional<io::KittiSequence> kitti_;
+    std::shared_ptr<const recordings::RecordedScans> recording_;
     std::vector<size_t> indices_;  // into the sequence, or into files_
     std::vector<std::filesystem::path> files_;
     std::vector<Eigen::Isometry3d> poses_;

@@ -1,0 +1,78 @@
+#pragma once
+// The sweeps of a recording as posed scans: one sensor_msgs/PointCloud2 topic, each cloud posed in
+// a fixed frame by the transform tree (/tf_static and /tf, or an odometry topic and /tf_static)
+// at its stamp, and deskewed when its points carry their own times (docs/recordings.md).
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "strata/core/Scan.hpp"
+#include "strata/recordings/Messages.hpp"
+#include "strata/recordings/Recording.hpp"
+#include "strata/recordings/TransformTree.hpp"
+
+namespace strata::recordings {
+
+/// @brief How the sweeps of a recording are chosen and posed.
+struct RecordedScanOptions {
+    std::string points_topic;  ///< empty: the recording's one PointCloud2 topic
+    std::string fixed_frame;   ///< empty: the tf tree's root (or the odometry's frame)
+    std::string odom_topic;    ///< nav_msgs/Odometry poses instead of /tf's (with /tf_static)
+    /// "A:B" (half-open, either side may be empty), "A" (one sweep) or empty for all, in stamp
+    /// order.
+    std::string frames;
+    bool deskew = true;  ///< where the clouds have per-point times and the poses are dense enough
+};
+
+/// @brief The sweeps, indexed by stamp; each is read and posed when asked for.
+class RecordedScans {
+public:
+    /// @brief Reads the recording's transforms and the clouds' stamps and frames (not their
+    /// points), and checks that every chosen sweep can be posed.
+    /// @throw NotFoundError for a missing topic or frame; InvalidArgumentError when the points
+    /// topic must be named (the refusal lists the candidates) or the frame range is bad;
+    /// RefusedError naming the sweep, its stamp and the trajectory's span when a sweep lies
+    /// outside it; the recording's FormatError for damage.
+    [[nodiscard]] static RecordedScans Open(const std::filesystem::path& path,
+                                            const RecordedScanOptions& options);
+
+    [[nodiscard]] size_t size() const { return sweeps_.size(); }
+
+    /// @brief Sweep `i` in the sensor's frame at its stamp, posed there (`T_world_sensor` is the
+    /// sensor in the fixed frame). Deskewed: each point moved by the pose of its own instant into
+    /// the frame of the stamp's.
+    /// @throw RefusedError when a point's time lies outside the trajectory; FormatError for a
+    /// damaged message.
+    [[nodiscard]] core::Scan Read(size_t i) const;
+
+    [[nodiscard]] const RecordingInfo& info() const { return recording_->info(); }
+    [[nodiscard]] const std::string& points_topic() const { return points_topic_; }
+    [[nodiscard]] const std::string& fixed_frame() const { return fixed_frame_; }
+    [[nodiscard]] const TransformTree& tree() const { return tree_; }
+    [[nodiscard]] bool deskewing() const { return deskew_; }
+    /// @brief Why the sweeps are or are not deskewed, for the program to say.
+    [[nodiscard]] const std::string& deskew_note() const { return deskew_note_; }
+
+private:
+    struct Sweep {
+        int64_t stamp_ns = 0;
+        std::string frame;
+        MessageLocation location;
+    };
+
+    [[nodiscard]] std::string Name(size_t i) const;
+
+    std::shared_ptr<const Recording> recording_;
+    TransformTree tree_;
+    std::vector<Sweep> sweeps_;  // the chosen ones, in stamp order
+    size_t first_ = 0;           // the first chosen sweep's index among all, for messages
+    std::string points_topic_, fixed_frame_, deskew_note_;
+    bool deskew_ = false;
+};
+
+}  // namespace strata::recordings

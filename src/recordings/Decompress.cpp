@@ -1,0 +1,68 @@
+#include "Decompress.hpp"
+
+#include <bzlib.h>
+#include <lz4frame.h>
+
+#include <limits>
+#include <memory>
+
+#include "FileReader.hpp"
+
+namespace strata::recordings::detail {
+
+void DecompressBz2(const uint8_t* data, size_t size, size_t expected, std::vector<uint8_t>& out,
+                   const std::string& where) {
+    if (size > std::numeric_limits<unsigned>::max() ||
+        expected > std::numeric_limits<unsigned>::max()) {
+        Fail(where, "bz2 chunk of " + std::to_string(size) + " bytes is larger than bzip2 reads");
+    }
+    out.resize(expected + 1);  // one spare byte: data that decompresses to more is caught
+    auto produced = static_cast<unsigned>(out.size());
+    // bzlib takes non-const pointers but does not write through `source`.
+    const int rc = BZ2_bzBuffToBuffDecompress(
+        reinterpret_cast<char*>(out.data()), &produced,
+        const_cast<char*>(reinterpret_cast<const char*>(data)), static_cast<unsigned>(size), 0, 0);
+    if (rc == BZ_OUTBUFF_FULL || (rc == BZ_OK && produced != expected)) {
+        Fail(where,
+             "bz2 chunk decompresses to " +
+                 (rc == BZ_OUTBUFF_FULL ? "more than" : std::to_string(produced) + " bytes, not") +
+                 " the " + std::to_string(expected) + " bytes its header declares");
+    }
+    if (rc != BZ_OK) Fail(where, "damaged bz2 chunk (bzip2 error " + std::to_string(rc) + ")");
+    out.resize(expected);
+}
+
+void DecompressLz4Frame(const uint8_t* data, size_t size, size_t expected,
+                        std::vector<uint8_t>& out, const std::string& where) {
+    LZ4F_dctx* raw = nullptr;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
+        throw std::bad_alloc();
+    }
+    const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> dctx(
+        raw, LZ4F_freeDecompressionContext);
+    out.resize(expected + 1);  // as above
+    size_t in_pos = 0, out_pos = 0, hint = 1;
+    while (in_pos < size && hint != 0) {
+        size_t in_n = size - in_pos, out_n = out.size() - out_pos;
+        hint = LZ4F_decompress(dctx.get(), out.data() + out_pos, &out_n, data + in_pos, &in_n,
+                               nullptr);
+        if (LZ4F_isError(hint)) {
+            Fail(where, std::string("damaged lz4 chunk: ") + LZ4F_getErrorName(hint));
+        }
+        in_pos += in_n;
+        out_pos += out_n;
+        if (in_n == 0 && out_n == 0) break;  // no progress: the output is full
+    }
+    if (hint != 0) {
+        Fail(where, out_pos > expected ? "lz4 chunk decompresses to more than the " +
+                                             std::to_string(expected) + " bytes its header declares"
+                                       : "lz4 chunk ends inside its frame (truncated)");
+    }
+    if (out_pos != expected) {
+        Fail(where, "lz4 chunk decompresses to " + std::to_string(out_pos) + " bytes, not the " +
+                        std::to_string(expected) + " bytes its header declares");
+    }
+    out.resize(expected);
+}
+
+}  // namespace strata::recordings::detail

@@ -1,0 +1,227 @@
+#!/usr/bin/env python3
+"""Writes a ROS 1 bag from a KITTI-layout folder with Debian's python3-rosbag: an independent
+writer of the recordings strata's tests read (tests/recordings/). Nothing of strata is used.
+
+  write_ros1_bag.py SEQ OUT.bag [--compression none|bz2|lz4] [--frames A:B] [--chunk-kb N]
+                    [--point-time none|t|time|timestamp|offset_time] [--float64] [--big-endian]
+                    [--extra-cloud-topic] [--tf-rate K] [--tf-from K] [--odom] [--rename-x]
+                    [--motion END_POSES]
+
+SEQ holds velodyne/NNNNNN.bin (float32 x y z intensity), poses.txt (camera 0 in the world, 3x4
+per line) and calib.txt (Tr: velodyne to camera 0); the velodyne in the world is
+inv(Tr) P Tr (the world frame is the first velodyne's, as SemanticKITTI's tools use it). Each scan becomes a sensor_msgs/PointCloud2
+on /velodyne_points in frame "velodyne", stamped 0.1 s apart from t0; /tf carries world ->
+base_link (K poses per scan interval, linearly interpolated between the scans' poses, so that the
+composed pose at each scan's stamp is the scan's own); /tf_static carries base_link -> velodyne,
+a fixed mounting. --odom writes the trajectory as nav_msgs/Odometry on /odom instead of /tf.
+--point-time adds a per-point time field (all points at the stamp, in that field's convention).
+--tf-from K leaves out the trajectory before scan K; --rename-x calls the x field "q" (broken
+recordings for the tests of refusals).
+--motion END_POSES: sweeps recorded while moving (strata's simulator with motion). Each scan has
+velodyne/NNNNNN.time (float32 seconds after the stamp, per point) and END_POSES the sensor's pose
+one revolution (0.1 s) after the stamp (3x4 per line, as poses.txt); the stamps come from
+times.txt, and /tf gets K poses across each sweep from its start to its end pose.
+"""
+import argparse
+import os
+import struct
+
+import numpy as np
+import rosbag
+import genpy
+from geometry_msgs.msg import TransformStamped
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import PointCloud2, PointField
+from std_msgs.msg import Header
+from tf2_msgs.msg import TFMessage
+
+T0 = 1317029540  # seconds: a KITTI-era epoch time
+# base_link -> velodyne: 1.2 m forward, 1.73 m up, yawed 2 degrees (any rigid mounting will do).
+MOUNT_YAW = np.radians(2.0)
+MOUNT = np.array([[np.cos(MOUNT_YAW), -np.sin(MOUNT_YAW), 0.0, 1.2],
+                  [np.sin(MOUNT_YAW), np.cos(MOUNT_YAW), 0.0, 0.0],
+                  [0.0, 0.0, 1.0, 1.73],
+                  [0.0, 0.0, 0.0, 1.0]])
+
+
+def read_matrix(line):
+    m = np.eye(4)
+    m[:3, :4] = np.array([float(v) for v in line.split()[-12:]]).reshape(3, 4)
+    return m
+
+
+def quaternion(r):
+    """x, y, z, w of a rotation matrix (Shepperd's method)."""
+    t = np.trace(r)
+    if t > 0:
+        s = np.sqrt(t + 1.0) * 2
+        return ((r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, 0.25 * s)
+    i = int(np.argmax(np.diag(r)))
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k]) * 2
+    q = [0.0, 0.0, 0.0, 0.0]
+    q[i] = 0.25 * s
+    q[j] = (r[j, i] + r[i, j]) / s
+    q[k] = (r[k, i] + r[i, k]) / s
+    q[3] = (r[k, j] - r[j, k]) / s
+    return tuple(q)
+
+
+def slerp(q0, q1, a):
+    q0, q1 = np.array(q0), np.array(q1)
+    d = float(np.dot(q0, q1))
+    if d < 0:
+        q1, d = -q1, -d
+    if d > 0.9995:
+        q = q0 + a * (q1 - q0)
+        return q / np.linalg.norm(q)
+    th = np.arccos(d)
+    return (np.sin((1 - a) * th) * q0 + np.sin(a * th) * q1) / np.sin(th)
+
+
+def transform(parent, child, stamp, m=None, q=None, p=None):
+    t = TransformStamped()
+    t.header = Header(stamp=stamp, frame_id=parent)
+    t.child_frame_id = child
+    if m is not None:
+        q, p = quaternion(m[:3, :3]), m[:3, 3]
+    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = p
+    (t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z,
+     t.transform.rotation.w) = q
+    return t
+
+
+TIME_FIELDS = {  # name: (datatype, struct code, value of a point `dt` seconds after the stamp)
+    't': (PointField.UINT32, 'I', lambda stamp, dt: int(round(dt * 1e9))),
+    'time': (PointField.FLOAT32, 'f', lambda stamp, dt: dt),
+    'timestamp': (PointField.FLOAT64, 'd', lambda stamp, dt: stamp.to_sec() + dt),
+    'offset_time': (PointField.UINT32, 'I', lambda stamp, dt: int(round(dt * 1e9))),
+}
+
+
+def cloud(points, stamp, args, dts):
+    msg = PointCloud2()
+    msg.header = Header(stamp=stamp, frame_id='velodyne')
+    msg.height, msg.width = 1, len(points)
+    endian = '>' if args.big_endian else '<'
+    coord, size = ('d', 8) if args.float64 else ('f', 4)
+    ctype = PointField.FLOAT64 if args.float64 else PointField.FLOAT32
+    # intensity first and a pad byte: the layout must be found by name, not assumed.
+    fields = [PointField('intensity', 0, PointField.FLOAT32, 1)]
+    offset = 5
+    for name in ('q' if args.rename_x else 'x', 'y', 'z'):
+        fields.append(PointField(name, offset, ctype, 1))
+        offset += size
+    code = endian + 'fx' + coord * 3
+    if args.point_time != 'none':
+        datatype, tcode, value = TIME_FIELDS[args.point_time]
+        fields.append(PointField(args.point_time, offset, datatype, 1))
+        offset += struct.calcsize('<' + tcode)
+        code += tcode
+    msg.fields = fields
+    msg.is_bigendian = args.big_endian
+    msg.point_step = struct.calcsize(code)
+    msg.row_step = msg.point_step * len(points)
+    out = bytearray()
+    for (x, y, z, i), dt in zip(points, dts):
+        values = [float(i), float(x), float(y), float(z)]
+        if args.point_time != 'none':
+            values.append(value(stamp, float(dt)))
+        out += struct.pack(code, *values)
+    msg.data = bytes(out)
+    msg.is_dense = True
+    return msg
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('seq')
+    ap.add_argument('out')
+    ap.add_argument('--compression', default='none', choices=['none', 'bz2', 'lz4'])
+    ap.add_argument('--frames', default='')
+    ap.add_argument('--chunk-kb', type=int, default=768)
+    ap.add_argument('--point-time', default='none', choices=['none'] + sorted(TIME_FIELDS))
+    ap.add_argument('--float64', action='store_true')
+    ap.add_argument('--big-endian', action='store_true')
+    ap.add_argument('--extra-cloud-topic', action='store_true')
+    ap.add_argument('--tf-rate', type=int, default=1)
+    ap.add_argument('--tf-from', type=int, default=0)
+    ap.add_argument('--odom', action='store_true')
+    ap.add_argument('--rename-x', action='store_true')
+    ap.add_argument('--motion', default='')
+    args = ap.parse_args()
+
+    tr = np.eye(4)
+    calib = os.path.join(args.seq, 'calib.txt')
+    if os.path.exists(calib):
+        with open(calib) as f:
+            tr = next((read_matrix(l) for l in f if l.startswith('Tr:')), tr)
+    with open(os.path.join(args.seq, 'poses.txt')) as f:
+        cams = [read_matrix(l) for l in f if l.strip()]
+    bins = sorted(f for f in os.listdir(os.path.join(args.seq, 'velodyne')) if f.endswith('.bin'))
+    a, _, b = args.frames.partition(':')
+    first = int(a) if a else 0
+    last = int(b) if b else len(bins)
+    frames = range(first, last)
+    # The sensor in the world, then the vehicle (base_link) under it through the mounting.
+    base = [np.linalg.inv(tr) @ cams[i] @ tr @ np.linalg.inv(MOUNT) for i in frames]
+    stamps = [genpy.Time(T0) + genpy.Duration.from_sec(0.1 * k) for k in range(len(base))]
+    ends = None
+    if args.motion:
+        with open(args.motion) as f:
+            end_cams = [read_matrix(l) for l in f if l.strip()]
+        ends = [np.linalg.inv(tr) @ end_cams[i] @ tr @ np.linalg.inv(MOUNT) for i in frames]
+        with open(os.path.join(args.seq, 'times.txt')) as f:
+            times = [float(l) for l in f if l.strip()]
+        stamps = [genpy.Time(T0) + genpy.Duration.from_sec(times[i]) for i in frames]
+
+    bag = rosbag.Bag(args.out, 'w', compression=args.compression,
+                     chunk_threshold=args.chunk_kb * 1024)
+    try:
+        bag.write('/tf_static', TFMessage([transform('base_link', 'velodyne', stamps[0], m=MOUNT)]),
+                  stamps[0])
+        for k, i in enumerate(frames):
+            points = np.fromfile(os.path.join(args.seq, 'velodyne', bins[i]),
+                                 dtype=np.float32).reshape(-1, 4)
+            dts = np.zeros(len(points))
+            if ends is not None:
+                dts = np.fromfile(os.path.join(args.seq, 'velodyne', bins[i][:-4] + '.time'),
+                                  dtype=np.float32)
+            msg = cloud(points, stamps[k], args, dts)
+            bag.write('/velodyne_points', msg, stamps[k])
+            if args.extra_cloud_topic:
+                bag.write('/velodyne_points_copy', msg, stamps[k])
+            if k < args.tf_from:
+                continue
+            # K poses from this scan's to the next one's (the last scan: its own alone), or with
+            # --motion K + 1 across the sweep, from its start to its end pose.
+            if ends is not None:
+                target, steps, last = ends[k], args.tf_rate, True
+            else:
+                target = base[k + 1] if k + 1 < len(base) else None
+                steps, last = (args.tf_rate, False) if target is not None else (1, False)
+            q0, p0 = quaternion(base[k][:3, :3]), base[k][:3, 3]
+            for s in range(steps + (1 if last else 0)):
+                alpha = s / steps
+                if s == 0:
+                    q, p = q0, p0
+                else:
+                    q1, p1 = quaternion(target[:3, :3]), target[:3, 3]
+                    q, p = tuple(slerp(q0, q1, alpha)), (1 - alpha) * p0 + alpha * p1
+                t = stamps[k] + genpy.Duration.from_sec(0.1 * alpha)
+                if args.odom:
+                    o = Odometry()
+                    o.header = Header(stamp=t, frame_id='world')
+                    o.child_frame_id = 'base_link'
+                    o.pose.pose.position.x, o.pose.pose.position.y, o.pose.pose.position.z = p
+                    (o.pose.pose.orientation.x, o.pose.pose.orientation.y,
+                     o.pose.pose.orientation.z, o.pose.pose.orientation.w) = q
+                    bag.write('/odom', o, t)
+                else:
+                    bag.write('/tf', TFMessage([transform('world', 'base_link', t, q=q, p=p)]), t)
+    finally:
+        bag.close()
+
+
+if __name__ == '__main__':
+    main()
