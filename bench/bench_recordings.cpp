@@ -1,5 +1,6 @@
 // Reading robot recordings (docs/recordings.md, docs/bench.md "Recordings"): KITTI 00's six scans
-// written by python3-rosbag as a ROS 1 bag (uncompressed, bz2 and lz4), then
+// written by python3-rosbag as a ROS 1 bag (uncompressed, bz2 and lz4) and by @mcap/core as MCAP
+// (uncompressed, lz4 and zstd), then
 //   - the container and the clouds' decoding: every PointCloud2 of the bag read and decoded, MB of
 //     bag per second on one thread (target: >= 200 MB/s uncompressed);
 //   - `integrate --bag` against `integrate --kitti` of the same scans, the whole use case
@@ -8,10 +9,14 @@
 // The median of --repeat runs (default 5). Exit 1 when a target is missed, 77 without KITTI 00
 // (1 under STRATA_REQUIRE_DATA=1).
 #include <tbb/global_control.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "BenchSupport.hpp"
 #include "strata/pipeline/Integrate.hpp"
@@ -26,12 +31,19 @@ using namespace strata;  // NOLINT(google-build-using-namespace): benchmark prog
 constexpr double kMinReadMBps = 200.0;
 constexpr double kMaxBagOverKitti = 1.10;
 
-fs::path WriteBag(const fs::path& seq, const fs::path& dir, const std::string& compression) {
-    const fs::path out = dir / ("kitti00_" + compression + ".bag");
+// The scans as a ROS 1 bag (`kind` "bag", by python3-rosbag) or an MCAP file ("mcap", by
+// @mcap/core) in `compression`.
+fs::path WriteRecording(const fs::path& seq, const fs::path& dir, const std::string& kind,
+                        const std::string& compression) {
+    const fs::path root(STRATA_SOURCE_DIR);
+    const fs::path out = dir / ("kitti00_" + compression + "." + kind);
+    const std::string writer =
+        kind == "mcap"
+            ? "NODE_PATH=" + (root / "build-deps/npm/node_modules").string() + " node " +
+                  (root / "tests/recordings/write_mcap.mjs").string()
+            : "/usr/bin/python3 " + (root / "tests/recordings/write_ros1_bag.py").string();
     const std::string command =
-        "/usr/bin/python3 " +
-        (fs::path(STRATA_SOURCE_DIR) / "tests/recordings/write_ros1_bag.py").string() + " " +
-        seq.string() + " " + out.string() + " --compression " + compression;
+        writer + " " + seq.string() + " " + out.string() + " --compression " + compression;
     if (std::system(command.c_str()) != 0) throw std::runtime_error("failed: " + command);
     return out;
 }
@@ -70,15 +82,21 @@ int main(int argc, char** argv) {
         fs::temp_directory_path() / ("strata_bench_recordings_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     bool missed = false;
-    std::printf("%-12s %10s %10s %10s\n", "bag", "MB", "s (median)", "MB/s");
-    for (const std::string compression : {"none", "lz4", "bz2"}) {
-        const fs::path bag = WriteBag(seq, dir, compression);
+    std::printf("%-12s %10s %10s %10s\n", "recording", "MB", "s (median)", "MB/s");
+    for (const auto& [kind, compression] :
+         std::vector<std::pair<std::string, std::string>>{{"bag", "none"},
+                                                          {"bag", "lz4"},
+                                                          {"bag", "bz2"},
+                                                          {"mcap", "none"},
+                                                          {"mcap", "lz4"},
+                                                          {"mcap", "zstd"}}) {
+        const fs::path bag = WriteRecording(seq, dir, kind, compression);
         std::vector<double> runs;
         size_t points = 0;
         for (int r = 0; r < repeat; ++r) runs.push_back(ReadSeconds(bag, &points));
         const double mb = static_cast<double>(fs::file_size(bag)) / 1e6, s = bench::Median(runs);
-        std::printf("%-12s %10.1f %10.4f %10.0f   (%zu points)\n", compression.c_str(), mb, s,
-                    mb / s, points);
+        std::printf("%-12s %10.1f %10.4f %10.0f   (%zu points)\n",
+                    (kind + " " + compression).c_str(), mb, s, mb / s, points);
         if (compression == "none" && mb / s < kMinReadMBps) missed = true;
     }
     pipeline::ScanSpec kitti, bag;

@@ -16,7 +16,9 @@ find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json 3 CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
-pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)  # ROS 1 bags' lz4 chunks
+pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)    # lz4 chunks of ROS 1 bags and MCAP
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)  # zstd chunks of MCAP
+find_package(ZLIB REQUIRED)                               # MCAP's CRC-32
 # Open MPI (libopenmpi-dev) for `mpirun strata ...`; without it strata runs as one process.
 find_package(MPI COMPONENTS CXX QUIET)
 if(MPI_CXX_FOUND)

@@ -11,12 +11,12 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-20}
 build="$root/build-fuzz"
-targets=(${STRATA_FUZZ_TARGETS:-kitti bin pcd ply las text text_bz2 poses scene map catalog ros1bag})
+targets=(${STRATA_FUZZ_TARGETS:-kitti bin pcd ply las text text_bz2 poses scene map catalog recording})
 
 # Largest input per target: a few records beyond the seeds, small enough to mutate quickly.
 declare -A max_len=([kitti]=1024 [bin]=1024 [pcd]=4096 [ply]=4096 [las]=4096 [text]=2048
                     [text_bz2]=2048 [poses]=2048 [scene]=8192 [map]=81920
-                    [catalog]=131072 [ros1bag]=16384)
+                    [catalog]=131072 [recording]=16384)
 
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (tools/setup.sh installs it)" >&2; exit 1; }
 start=$(date +%s)
@@ -30,12 +30,18 @@ echo "fuzz.sh: build took $(($(date +%s) - start)) s"
 
 rm -rf "$build/seeds"
 "$build/tests/fuzz/fuzz_make_corpus" "$build/seeds"
-# Seed bags by an independent writer, Debian's python3-rosbag (tools/setup.sh installs it), in
-# each compression, with per-point times and poses denser than the sweeps.
-mkdir -p "$build/seeds/ros1bag"
+# Seed recordings by independent writers (tools/setup.sh installs them): ROS 1 bags by Debian's
+# python3-rosbag, MCAP files by @mcap/core, in each compression, with per-point times and poses
+# denser than the sweeps.
+mkdir -p "$build/seeds/recording"
 for c in none bz2 lz4; do
-  /usr/bin/python3 "$root/tests/recordings/write_ros1_bag.py" "$build/seeds/_ros1bag_seq" \
-    "$build/seeds/ros1bag/$c.bag" --compression "$c" --chunk-kb 1 --point-time t --tf-rate 3
+  /usr/bin/python3 "$root/tests/recordings/write_ros1_bag.py" "$build/seeds/_recording_seq" \
+    "$build/seeds/recording/$c.bag" --compression "$c" --chunk-kb 1 --point-time t --tf-rate 3
+done
+for c in none lz4 zstd; do
+  NODE_PATH="$root/build-deps/npm/node_modules" node "$root/tests/recordings/write_mcap.mjs" \
+    "$build/seeds/_recording_seq" "$build/seeds/recording/$c.mcap" --compression "$c" \
+    --chunk-kb 1 --point-time t --tf-rate 3
 done
 mkdir -p "$build/corpus" "$build/artifacts" "$build/logs"
 

@@ -34,10 +34,11 @@ packages=(
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, docs/python.md)
   python3-matplotlib                      # docs/python.md's plotting example (tested)
   groff-base                              # the install test reads the man pages (groff)
-  liblz4-dev                              # ROS 1 bags' lz4 chunks (src/recordings/)
+  liblz4-dev libzstd-dev zlib1g-dev       # recordings' chunks and CRCs (src/recordings/)
   # An independent writer of the test recordings: ROS 1 bags by rosbag (tests/recordings/).
   python3-rosbag python3-roslz4 python3-sensor-msgs python3-tf2-msgs python3-nav-msgs
   python3-geometry-msgs
+  nodejs lz4 zstd  # and MCAP files by @mcap/core (below), chunks compressed by lz4 and zstd
 )
 
 missing=()
@@ -51,6 +52,22 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   "${sudo_cmd[@]}" apt-get update -qq
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The independent writers of the MCAP test recordings (tests/recordings/write_mcap.mjs), from the
+# machine's npm registry into the ignored build-deps/npm/ (tests set NODE_PATH there). Pinned by
+# major version; installed once.
+npm_dir="$(cd "$(dirname "$0")/.." && pwd)/build-deps/npm"
+if [[ ! -d $npm_dir/node_modules/@mcap/core || ! -d $npm_dir/node_modules/@foxglove/rosmsg ||
+      ! -d $npm_dir/node_modules/@foxglove/rosmsg2-serialization ]]; then
+  if ! command -v npm >/dev/null; then
+    sudo_cmd=()
+    [[ $(id -u) -eq 0 ]] || sudo_cmd=(sudo)
+    DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends npm
+  fi
+  mkdir -p "$npm_dir"
+  npm install --prefix "$npm_dir" --no-audit --no-fund --loglevel=error \
+    @mcap/core@2 @foxglove/rosmsg2-serialization@3 @foxglove/rosmsg@5
 fi
 
 # The source package of the installed libtbb, for tools/sanitize.sh tsan: ThreadSanitizer needs

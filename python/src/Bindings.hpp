@@ -9,7 +9,7 @@ namespace py = pybind11;
 
 /// strata.Error and one subclass per kind of strata::Error (include/strata/core/Error.hpp).
 void RegisterErrors(py::module_& m);
-/// read_points, read_kitti.
+/// read_points, read_kitti, read_bag.
 void RegisterReaders(py::module_& m);
 /// The simulator, one scan at a time (strata.simulate wraps it in a generator).
 void RegisterSimulation(py::module_& m);

@@ -1,4 +1,5 @@
-// strata.read_points and strata.read_kitti: the io readers, arrays out.
+// strata.read_points, strata.read_kitti and strata.read_bag: the io readers and a recording's
+// sweeps, arrays out.
 #include <filesystem>
 
 #include "Arrays.hpp"
@@ -6,6 +7,7 @@
 #include "strata/core/Error.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PointCloudReaders.hpp"
+#include "strata/recordings/RecordedScans.hpp"
 
 namespace strata::python {
 
@@ -83,6 +85,38 @@ void RegisterReaders(py::module_& m) {
     m.def("_read_points", &ReadPoints, py::arg("path"), py::arg("bin_fields") = 0,
           py::arg("origin") = py::none());
     m.def("_read_kitti", &ReadKitti, py::arg("dir"));
+    // A recording's sweeps, one at a time (strata.read_bag wraps it in a generator).
+    using recordings::RecordedScans;
+    py::class_<RecordedScans>(m, "_Recording")
+        .def(py::init([](const std::string& path, const std::string& points_topic,
+                         const std::string& fixed_frame, const std::string& odom_topic, bool deskew,
+                         const std::string& frames) {
+                 RequireExists(path);
+                 recordings::RecordedScanOptions options;
+                 options.points_topic = points_topic;
+                 options.fixed_frame = fixed_frame;
+                 options.odom_topic = odom_topic;
+                 options.deskew = deskew;
+                 options.frames = frames;
+                 py::gil_scoped_release release;
+                 return RecordedScans::Open(path, options);
+             }),
+             py::arg("path"), py::arg("points_topic"), py::arg("fixed_frame"),
+             py::arg("odom_topic"), py::arg("deskew"), py::arg("frames"))
+        .def("__len__", &RecordedScans::size)
+        .def("scan",
+             [](const RecordedScans& scans, size_t k) {
+                 if (k >= scans.size()) throw py::index_error("no sweep " + std::to_string(k));
+                 core::Scan scan;
+                 {
+                     py::gil_scoped_release release;
+                     scan = scans.Read(k);
+                 }
+                 return ScanToDict(std::move(scan));
+             })
+        .def_property_readonly("points_topic", &RecordedScans::points_topic)
+        .def_property_readonly("fixed_frame", &RecordedScans::fixed_frame)
+        .def_property_readonly("deskew_note", &RecordedScans::deskew_note);
 }
 
 }  // namespace strata::python

@@ -16,7 +16,7 @@ from ._strata import (CLASSES, Error, FormatError, InvalidArgumentError, IoError
 
 __all__ = ["CLASSES", "Error", "FormatError", "InvalidArgumentError", "IoError", "Map",
            "MapLockedError", "NotFoundError", "RefusedError", "Scan", "Session", "VoxelMap",
-           "read_kitti", "read_points", "simulate"]
+           "read_bag", "read_kitti", "read_points", "simulate"]
 
 
 @dataclass
@@ -57,6 +57,34 @@ def read_kitti(sequence) -> dict:
     "times": (N,)}. Read a scan with np.fromfile(path, np.float32).reshape(-1, 4)[:, :3].
     """
     return _strata._read_kitti(str(sequence))
+
+
+def read_bag(path, points_topic: Optional[str] = None, fixed_frame: Optional[str] = None,
+             odom_topic: Optional[str] = None, deskew: bool = True,
+             frames: Optional[str] = None) -> Iterator[Scan]:
+    """Yields the sweeps of a robot recording, posed and deskewed, as `strata integrate --bag`
+    reads them (docs/recordings.md): a ROS 1 .bag, an MCAP file, or a rosbag2 SQLite bag (a
+    .db3 file or its folder).
+
+    points_topic: the sensor_msgs/PointCloud2 topic (needed when there are several); fixed_frame:
+    the frame of the poses (default: the tf tree's root); odom_topic: a nav_msgs/Odometry topic
+    to pose the sweeps by instead of /tf; deskew: move each point by the pose of its own time
+    where the clouds carry per-point times; frames: "A:B", the sweeps to read. Each Scan has
+    float64 points in the sensor frame at the sweep's stamp, the pose there, intensity (or None)
+    and the stamp as `time`. The recording is opened (and every refusal raised) at the call;
+    the sweeps are read one at a time as the generator is iterated. To map them:
+    `with m.session("drive") as s: for scan in strata.read_bag(p): s.integrate(scan.points,
+    scan.pose)`.
+    """
+    rec = _strata._Recording(str(path), points_topic or "", fixed_frame or "", odom_topic or "",
+                             deskew, frames or "")
+
+    def sweeps():
+        for k in range(len(rec)):
+            d = rec.scan(k)
+            yield Scan(points=d["points"], pose=d["pose"], intensity=d["intensity"],
+                       time=d["time"])
+    return sweeps()
 
 
 def simulate(scene="demo", session: int = 0, sensor: Optional[str] = None,

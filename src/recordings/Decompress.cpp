@@ -2,13 +2,24 @@
 
 #include <bzlib.h>
 #include <lz4frame.h>
+#include <zlib.h>
+#include <zstd.h>
+#include <zstd_errors.h>
 
+#include <algorithm>
 #include <limits>
 #include <memory>
 
 #include "FileReader.hpp"
 
 namespace strata::recordings::detail {
+
+void CheckDeclaredSize(size_t compressed, uint64_t declared, const std::string& where) {
+    if (declared > (uint64_t{64} << 20) && declared / 2000 > compressed) {
+        Fail(where, "a chunk of " + std::to_string(compressed) + " bytes declares " +
+                        std::to_string(declared) + " uncompressed (damaged)");
+    }
+}
 
 void DecompressBz2(const uint8_t* data, size_t size, size_t expected, std::vector<uint8_t>& out,
                    const std::string& where) {
@@ -63,6 +74,34 @@ void DecompressLz4Frame(const uint8_t* data, size_t size, size_t expected,
                         std::to_string(expected) + " bytes its header declares");
     }
     out.resize(expected);
+}
+
+void DecompressZstd(const uint8_t* data, size_t size, size_t expected, std::vector<uint8_t>& out,
+                    const std::string& where) {
+    out.resize(expected);
+    const size_t n = ZSTD_decompress(out.data(), out.size(), data, size);
+    if (ZSTD_isError(n)) {
+        if (ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall) {
+            Fail(where, "zstd chunk decompresses to more than the " + std::to_string(expected) +
+                            " bytes its header declares");
+        }
+        Fail(where, std::string("damaged zstd chunk: ") + ZSTD_getErrorName(n));
+    }
+    if (n != expected) {
+        Fail(where, "zstd chunk decompresses to " + std::to_string(n) + " bytes, not the " +
+                        std::to_string(expected) + " bytes its header declares");
+    }
+}
+
+uint32_t Crc32(const uint8_t* data, size_t size) {
+    uLong crc = crc32(0L, Z_NULL, 0);
+    while (size > 0) {  // zlib takes 32-bit lengths
+        const auto n = static_cast<uInt>(std::min<size_t>(size, 1u << 30));
+        crc = crc32(crc, data, n);
+        data += n;
+        size -= n;
+    }
+    return static_cast<uint32_t>(crc);
 }
 
 }  // namespace strata::recordings::detail

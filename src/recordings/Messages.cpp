@@ -21,6 +21,10 @@ public:
         : in_(m.data, m.size,
               file + ": " + m.topic->name + " message logged at " + FormatStamp(m.log_time_ns)),
           cdr_(m.topic->encoding == Encoding::kCdr) {
+        if (m.topic->encoding == Encoding::kOther) {
+            in_.Fail(
+                "its messages are not serialized as ROS 1 or CDR: strata does not decode them");
+        }
         if (cdr_) {
             const uint8_t* h = in_.Take(4, "CDR encapsulation header");
             // 0x0000 CDR_BE, 0x0001 CDR_LE; XCDR2's plain forms (0x0006, 0x0007) lay out these

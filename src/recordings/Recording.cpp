@@ -1,8 +1,12 @@
 #include "strata/recordings/Recording.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
+#include "Mcap.hpp"
 #include "Ros1Bag.hpp"
+#include "Rosbag2Sqlite.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::recordings {
 
@@ -14,7 +18,24 @@ const Topic* RecordingInfo::Find(const std::string& name) const {
 }
 
 std::unique_ptr<Recording> Recording::Open(const std::filesystem::path& path) {
-    return std::make_unique<detail::Ros1Bag>(path);
+    // By content, not by name: a `.bag` may be either (ros2 bag's MCAP files are often renamed).
+    if (std::filesystem::is_directory(path)) return std::make_unique<detail::Rosbag2Sqlite>(path);
+    std::vector<uint8_t> first;
+    {
+        const detail::FileReader file(path);
+        file.Read(0, std::min<uint64_t>(file.size(), 16), first, "first bytes");
+    }
+    const std::string start(first.begin(), first.end());
+    if (start.rfind("#ROSBAG", 0) == 0) return std::make_unique<detail::Ros1Bag>(path);
+    if (start.size() >= 5 && start.compare(1, 4, "MCAP") == 0 && first[0] == 0x89) {
+        return std::make_unique<detail::Mcap>(path);
+    }
+    if (start == std::string("SQLite format 3\0", 16)) {
+        return std::make_unique<detail::Rosbag2Sqlite>(path);
+    }
+    throw FormatError(path.string() +
+                      ": not a recording strata reads (a ROS 1 bag, an MCAP file or a rosbag2 "
+                      ".db3 file, by its first bytes; or a rosbag2 folder)");
 }
 
 std::string FormatStamp(int64_t ns) {

@@ -154,20 +154,10 @@ Ros1Bag::Ros1Bag(const std::filesystem::path& path) : file_(path) {
         }
         ReadIndex(index_pos, conn_count, chunk_count);
     }
-    std::sort(info_.topics.begin(), info_.topics.end(),
-              [](const Topic& a, const Topic& b) { return a.name < b.name; });
-    // Topic indices moved with the sort: map them again by name.
-    for (auto& [id, c] : connections_) c.topic = TopicIndex(connection_topics_.at(id));
+    topics_.Finish(info_);
 }
 
 Ros1Bag::~Ros1Bag() = default;
-
-size_t Ros1Bag::TopicIndex(const std::string& topic) const {
-    for (size_t i = 0; i < info_.topics.size(); ++i) {
-        if (info_.topics[i].name == topic) return i;
-    }
-    return info_.topics.size();
-}
 
 void Ros1Bag::AddConnection(const uint8_t* header, size_t header_size, const uint8_t* data,
                             size_t data_size, const std::string& where) {
@@ -175,22 +165,7 @@ void Ros1Bag::AddConnection(const uint8_t* header, size_t header_size, const uin
     const auto id = h.Scalar<uint32_t>("conn");
     const std::string topic = h.String("topic");
     const Fields d(data, data_size, where);
-    const std::string type = d.String("type");
-    if (connection_topics_.count(id) != 0) {
-        if (connection_topics_.at(id) != topic) {
-            Fail(where, "connection " + std::to_string(id) + " is recorded for two topics");
-        }
-        return;
-    }
-    size_t t = TopicIndex(topic);
-    if (t == info_.topics.size()) {
-        info_.topics.push_back({topic, type, Encoding::kRos1, 0});
-    } else if (info_.topics[t].type != type) {
-        Fail(where, "topic " + topic + " is recorded with two types, " + info_.topics[t].type +
-                        " and " + type);
-    }
-    connection_topics_[id] = topic;
-    connections_[id] = Connection{id, t};
+    topics_.Add(id, topic, d.String("type"), Encoding::kRos1, where);
 }
 
 void Ros1Bag::ReadIndex(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count) {
@@ -248,12 +223,11 @@ void Ros1Bag::ReadIndex(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_
                        std::to_string(conn_count) + " and " + std::to_string(chunk_count));
     }
     for (const auto& [conn, n] : counts) {
-        const auto it = connections_.find(conn);
-        if (it == connections_.end()) {
+        if (!topics_.Has(conn)) {
             Fail(name, "the index counts messages of connection " + std::to_string(conn) +
                            ", which it does not declare");
         }
-        info_.topics[it->second.topic].messages += n;
+        topics_.Count(conn, n);
     }
     std::sort(chunks_.begin(), chunks_.end(),
               [](const Chunk& a, const Chunk& b) { return a.position < b.position; });
@@ -278,13 +252,12 @@ void Ros1Bag::ScanRecords() {
             chunk.position = offset;
             const auto on_message = [&](uint32_t conn, int64_t t, const uint8_t*, size_t,
                                         uint64_t) {
-                const auto it = connections_.find(conn);
-                if (it == connections_.end()) {
+                if (!topics_.Has(conn)) {
                     Fail(At(name, "chunk", offset), "a message of connection " +
                                                         std::to_string(conn) +
                                                         " before its connection record");
                 }
-                ++info_.topics[it->second.topic].messages;
+                topics_.Count(conn, 1);
                 if (info_.start_ns == 0 || t < info_.start_ns) info_.start_ns = t;
                 info_.end_ns = std::max(info_.end_ns, t);
                 chunk.connections.insert(conn);
@@ -317,12 +290,7 @@ std::vector<uint8_t> Ros1Bag::Uncompress(const std::vector<uint8_t>& header,
     const std::string compression = h.String("compression");
     const auto size = h.Scalar<uint32_t>("size");
     std::vector<uint8_t> plain;
-    // No compressor comes near 2000:1 on sensor data; a larger claim is damage, refused before
-    // the memory is taken.
-    if (size > (64u << 20) && size / 2000 > data.size()) {
-        Fail(where, "a chunk of " + std::to_string(data.size()) + " bytes declares " +
-                        std::to_string(size) + " uncompressed (damaged)");
-    }
+    CheckDeclaredSize(data.size(), size, where);
     if (compression == "none") {
         if (data.size() != size) {
             Fail(where, "uncompressed chunk of " + std::to_string(data.size()) +
@@ -367,21 +335,7 @@ void Ros1Bag::VisitChunk(const std::vector<uint8_t>& records, uint64_t offset,
 }
 
 void Ros1Bag::Read(const std::vector<std::string>& topics, const Visitor& visit) const {
-    std::set<uint32_t> wanted;
-    for (const std::string& t : topics) {
-        if (info_.Find(t) == nullptr) {
-            std::string names;
-            for (const Topic& k : info_.topics) names += (names.empty() ? "" : ", ") + k.name;
-            throw NotFoundError(file_.name() + ": no topic " + t + " (it has " +
-                                (names.empty() ? "none" : names) + ")");
-        }
-    }
-    for (const auto& [id, c] : connections_) {
-        if (topics.empty() ||
-            std::find(topics.begin(), topics.end(), info_.topics[c.topic].name) != topics.end()) {
-            wanted.insert(id);
-        }
-    }
+    const std::set<uint32_t> wanted = topics_.Streams(topics, info_);
     for (const Chunk& chunk : chunks_) {
         const bool any = std::any_of(chunk.connections.begin(), chunk.connections.end(),
                                      [&](uint32_t c) { return wanted.count(c) != 0; });
@@ -392,8 +346,7 @@ void Ros1Bag::Read(const std::vector<std::string>& topics, const Visitor& visit)
             Uncompress(r.header, std::move(r.data), chunk.position), chunk.position,
             [&](uint32_t conn, int64_t t, const uint8_t* data, size_t size, uint64_t record) {
                 if (wanted.count(conn) == 0) return;
-                const auto it = connections_.find(conn);
-                visit(Message{&info_.topics[it->second.topic], t, data, size,
+                visit(Message{topics_.TopicOf(conn, info_), t, data, size,
                               MessageLocation{chunk.position, record}});
             },
             {});
@@ -419,10 +372,9 @@ void Ros1Bag::ReadMessage(const MessageLocation& location, const Visitor& visit)
     const uint8_t* data = in.Take(data_size, "record data");
     const Fields f(header, header_size, where);
     if (f.Op() != kOpMessage) Fail(where, "no message at " + std::to_string(location.record));
-    const auto it = connections_.find(f.Scalar<uint32_t>("conn"));
-    if (it == connections_.end()) Fail(where, "a message of an undeclared connection");
-    visit(Message{&info_.topics[it->second.topic], TimeNs(f.Scalar<uint64_t>("time")), data,
-                  data_size, location});
+    const Topic* topic = topics_.TopicOf(f.Scalar<uint32_t>("conn"), info_);
+    if (topic == nullptr) Fail(where, "a message of an undeclared connection");
+    visit(Message{topic, TimeNs(f.Scalar<uint64_t>("time")), data, data_size, location});
 }
 
 }  // namespace strata::recordings::detail

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "FileReader.hpp"
+#include "TopicTable.hpp"
 #include "strata/recordings/Recording.hpp"
 
 namespace strata::recordings::detail {
@@ -23,10 +24,6 @@ public:
     void ReadMessage(const MessageLocation& location, const Visitor& visit) const override;
 
 private:
-    struct Connection {
-        uint32_t id = 0;
-        size_t topic = 0;  // index into info_.topics
-    };
     struct Chunk {
         uint64_t position = 0;
         std::set<uint32_t> connections;  // those with messages in it
@@ -49,13 +46,11 @@ private:
     // Calls the callbacks for a chunk's records, in order.
     void VisitChunk(const std::vector<uint8_t>& records, uint64_t offset,
                     const OnMessage& on_message, const OnConnection& on_connection) const;
-    [[nodiscard]] size_t TopicIndex(const std::string& topic) const;
 
     FileReader file_;
     RecordingInfo info_;
     uint64_t first_record_ = 0;
-    std::map<uint32_t, Connection> connections_;
-    std::map<uint32_t, std::string> connection_topics_;
+    TopicTable topics_;  // connections
     std::vector<Chunk> chunks_;
     // ReadMessage's last chunk, uncompressed.
     mutable std::mutex cache_mutex_;

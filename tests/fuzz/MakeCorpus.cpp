@@ -132,9 +132,9 @@ void WriteSeeds(const fs::path& out) {
     const std::string tile = fuzz::CreateSmallMap(map_dir);
     Seed(out, "map", "tile.vdb", Slurp(map_dir / tile));
     Seed(out, "catalog", "catalog.sqlite", Slurp(map_dir / "catalog.sqlite"));
-    // ROS 1 bags: two scans of eight points with their poses, a KITTI-layout folder that
-    // tools/fuzz.sh has python3-rosbag write as bags (tests/recordings/write_ros1_bag.py).
-    const fs::path seq = out / "_ros1bag_seq";
+    // Recordings: two scans of eight points with their poses, a KITTI-layout folder that
+    // tools/fuzz.sh has python3-rosbag and @mcap/core write as bags and MCAP files.
+    const fs::path seq = out / "_recording_seq";
     fs::create_directories(seq / "velodyne");
     for (int k = 0; k < 2; ++k) {
         std::vector<Eigen::Vector3d> points;

@@ -1,14 +1,20 @@
 #pragma once
-// Recordings written by tools strata did not write: ROS 1 bags by Debian's python3-rosbag
-// (tests/recordings/write_ros1_bag.py), from a KITTI-layout folder of scans and poses.
+// Recordings written by tools strata did not write, from a KITTI-layout folder of scans and poses:
+// ROS 1 bags by Debian's python3-rosbag (tests/recordings/write_ros1_bag.py), MCAP files by the
+// npm packages @mcap/core and @foxglove/rosmsg2-serialization (tests/recordings/write_mcap.mjs,
+// installed by tools/setup.sh into build-deps/npm).
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "SyntheticRoom.hpp"
 #include "TempPath.hpp"
+#include "strata/recordings/Messages.hpp"
+#include "strata/recordings/Recording.hpp"
 
 namespace strata::recordings::test {
 
@@ -39,6 +45,33 @@ inline fs::path WriteRos1Bag(const fs::path& seq, const std::string& name,
     return out;
 }
 
+/// The scans of `seq` as an MCAP file at a fresh temporary path, written by @mcap/core with
+/// write_mcap.mjs's `options`.
+inline fs::path WriteMcap(const fs::path& seq, const std::string& name,
+                          const std::string& options = "") {
+    const fs::path out = strata::test::TempPath(name + ".mcap");
+    const fs::path root(STRATA_SOURCE_DIR);
+    Run("NODE_PATH=" + (root / "build-deps/npm/node_modules").string() + " node " +
+        (root / "tests/recordings/write_mcap.mjs").string() + " " + seq.string() + " " +
+        out.string() + " " + options);
+    return out;
+}
+
+/// The scans of `seq` as a rosbag2 SQLite bag folder at a fresh temporary path: the messages'
+/// CDR bytes from write_mcap.mjs (@foxglove/rosmsg2-serialization), the .db3 files and
+/// metadata.yaml from write_db3.py (Python's sqlite3) with its `options` (--split N).
+inline fs::path WriteDb3(const fs::path& seq, const std::string& name,
+                         const std::string& options = "") {
+    const fs::path dump = strata::test::TempPath(name + "_cdr");
+    const fs::path out = strata::test::TempPath(name + "_rosbag2");
+    fs::remove_all(out);
+    (void)WriteMcap(seq, name + "_dumped", "--dump " + dump.string());
+    Run(std::string(STRATA_PYTHON3) + " " +
+        (fs::path(STRATA_SOURCE_DIR) / "tests/recordings/write_db3.py").string() + " " +
+        dump.string() + " " + out.string() + " " + options);
+    return out;
+}
+
 /// The room of SyntheticRoom.hpp seen from three poses, as a KITTI-layout folder (made once per
 /// process).
 inline const fs::path& RoomSequence() {
@@ -48,6 +81,42 @@ inline const fs::path& RoomSequence() {
         return strata::test::MakeSequence(strata::test::TempPath("bag_room"), spec);
     }();
     return dir;
+}
+
+/// What `f` threw as E (its message), or "(no error)".
+template <typename E, typename F>
+std::string Refusal(F&& f) {
+    try {
+        f();
+    } catch (const E& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+/// A file's bytes.
+inline std::string Bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+/// `bytes` in a fresh temporary file called `name` (with its extension).
+inline fs::path WriteBytes(const std::string& bytes, const std::string& name) {
+    const fs::path p = strata::test::TempPath(name);
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p;
+}
+
+/// Reads every message of a recording and decodes its clouds and transforms (or fails opening
+/// or reading it).
+inline void ReadAll(const fs::path& path) {
+    const auto recording = Recording::Open(path);
+    recording->Read({}, [&](const Message& m) {
+        if (IsType(*m.topic, "sensor_msgs/PointCloud2")) (void)DecodePointCloud2(m, path.string());
+        if (IsType(*m.topic, "tf2_msgs/TFMessage")) (void)DecodeTfMessage(m, path.string());
+    });
 }
 
 /// Seconds of the first stamp write_ros1_bag.py gives (its T0); the scans are 0.1 s apart.

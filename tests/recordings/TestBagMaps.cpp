@@ -43,17 +43,20 @@ size_t DifferingVoxels(const core::VoxelMap& a, const core::VoxelMap& b) {
     return differing;
 }
 
-// The map of `seq`'s scans from their KITTI folder and from a bag of them (`compression`): the
-// number of voxels that differ, and MapDifference's first difference in `first`.
+// The map of `seq`'s scans from their KITTI folder and from a recording of them (a ROS 1 bag, or
+// an MCAP file when `mcap`, in `compression`): the number of voxels that differ, and
+// MapDifference's first difference in `first`.
 size_t MapDifferences(const fs::path& seq, const std::string& frames,
-                      const std::string& compression, double voxel, std::string* first) {
+                      const std::string& compression, double voxel, std::string* first,
+                      bool mcap = false) {
     pipeline::ScanSpec kitti;
     kitti.kitti = seq;
     kitti.frames = frames;
     pipeline::ScanSpec bag;
-    bag.bag = WriteRos1Bag(
-        seq, "map_" + compression,
-        "--compression " + compression + (frames.empty() ? "" : " --frames " + frames));
+    bag.bag = mcap ? WriteMcap(seq, "map_" + compression, "--compression " + compression)
+                   : WriteRos1Bag(seq, "map_" + compression,
+                                  "--compression " + compression +
+                                      (frames.empty() ? "" : " --frames " + frames));
     const core::VoxelMap expected = Integrated(kitti, "kitti_" + compression, voxel);
     const core::VoxelMap actual = Integrated(bag, "bag_" + compression, voxel);
     EXPECT_GT(expected.occupancy->activeVoxelCount(), 1000u);
@@ -68,6 +71,24 @@ TEST(BagMaps, TheRoomFromABagInEachCompressionIsTheRoomFromItsKittiFolder) {
         EXPECT_EQ(MapDifferences(RoomSequence(), "", compression, 0.1, &first), 0u);
         EXPECT_EQ(first, "");
     }
+}
+
+TEST(BagMaps, TheRoomFromAnMcapInEachCompressionIsTheRoomFromItsKittiFolder) {
+    for (const std::string compression : {"none", "lz4", "zstd"}) {
+        SCOPED_TRACE(compression);
+        std::string first;
+        EXPECT_EQ(MapDifferences(RoomSequence(), "", compression, 0.1, &first, true), 0u);
+        EXPECT_EQ(first, "");
+    }
+}
+
+TEST(BagMaps, TheRoomFromARosbag2SqliteBagIsTheRoomFromItsKittiFolder) {
+    pipeline::ScanSpec kitti, db3;
+    kitti.kitti = RoomSequence();
+    db3.bag = WriteDb3(RoomSequence(), "map_db3", "--split 3");
+    EXPECT_EQ(strata::testing::MapDifference(Integrated(db3, "db3", 0.1),
+                                             Integrated(kitti, "kitti_db3", 0.1)),
+              "");
 }
 
 TEST(BagMaps, Kitti00FramesFromABagAreTheKittiMap) {

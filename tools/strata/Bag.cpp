@@ -1,5 +1,5 @@
-// strata bag info: what a robot recording holds, as `rosbag info` and `ros2 bag info` print it,
-// with its tf tree.
+// strata bag info: what a robot recording (a ROS 1 bag or an MCAP file) holds, as `rosbag info`
+// and `ros2 bag info` print it, with its tf tree.
 #include <cstdint>
 #include <iomanip>
 #include <iostream>
@@ -49,7 +49,7 @@ void PrintText(const nlohmann::json& j) {
 }  // namespace
 
 void RegisterBag(CLI::App& app) {
-    CLI::App* bag = app.add_subcommand("bag", "Robot recordings (ROS 1 .bag)");
+    CLI::App* bag = app.add_subcommand("bag", "Robot recordings (ROS 1 .bag, MCAP)");
     bag->require_subcommand(1);
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);

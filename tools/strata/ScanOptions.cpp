@@ -13,7 +13,7 @@ void AddBinFieldsOption(CLI::App& cmd, int& bin_fields) {
 void AddScanOptions(CLI::App& cmd, pipeline::ScanSpec& spec) {
     cmd.add_option("--kitti", spec.kitti, "KITTI/SemanticKITTI sequence folder");
     cmd.add_option("--bag", spec.bag,
-                   "A robot recording (ROS 1 .bag): its PointCloud2 sweeps posed by /tf");
+                   "A robot recording (ROS 1 .bag or MCAP): its PointCloud2 sweeps posed by /tf");
     cmd.add_option("--frames", spec.frames,
                    "Frame range A:B of the sequence, or of the recording's sweeps (half-open)");
     recordings::RecordedScanOptions& r = spec.recording;

@@ -20,7 +20,7 @@ namespace strata::pipeline {
 /// `kitti`, `files` and `bag`.
 struct ScanSpec {
     std::filesystem::path kitti;  ///< KITTI / SemanticKITTI sequence folder
-    std::filesystem::path bag;    ///< a ROS 1 bag
+    std::filesystem::path bag;    ///< a recording: a ROS 1 bag or an MCAP file
     /// "A:B" (half-open, either side may be empty), "A" (one frame) or empty for all.
     std::string frames;
     /// How the recording's sweeps are chosen and posed (its `frames` is the one above).

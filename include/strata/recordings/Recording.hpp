@@ -1,6 +1,7 @@
 #pragma once
 // Robot recordings as containers: which topics a recording holds and the bytes of their messages.
-// ROS 1 bags (format 2.0; chunks uncompressed, bz2 or lz4) are read here; Messages.hpp decodes the
+// ROS 1 bags (format 2.0; chunks uncompressed, bz2 or lz4), MCAP (chunks uncompressed, lz4 or
+// zstd) and rosbag2's SQLite storage are read here; Messages.hpp decodes the
 // messages that carry maps and TransformTree.hpp composes their poses (docs/recordings.md).
 
 #include <cstddef>
@@ -13,9 +14,9 @@
 
 namespace strata::recordings {
 
-/// @brief How a topic's messages are serialized: ROS 1's, or ROS 2's CDR (with its 4-byte
-/// encapsulation header).
-enum class Encoding : uint8_t { kRos1, kCdr };
+/// @brief How a topic's messages are serialized: ROS 1's, ROS 2's CDR (with its 4-byte
+/// encapsulation header), or another (MCAP's json, protobuf, ...: listed, not decoded).
+enum class Encoding : uint8_t { kRos1, kCdr, kOther };
 
 /// @brief One topic of a recording, with everything recorded on it.
 struct Topic {
@@ -44,7 +45,7 @@ struct Message {
 /// has none).
 struct RecordingInfo {
     std::filesystem::path path;
-    std::string format;       ///< "ROS 1 bag 2.0"
+    std::string format;       ///< "ROS 1 bag 2.0", "MCAP" or "rosbag2 SQLite"
     std::string compression;  ///< the chunks' compressions, e.g. "lz4" or "none, bz2"
     uint64_t bytes = 0;       ///< the file's size
     uint64_t chunks = 0;
@@ -65,7 +66,8 @@ public:
 
     virtual ~Recording() = default;
 
-    /// @brief Opens a ROS 1 bag (`.bag`, recognised by its first line).
+    /// @brief Opens a ROS 1 bag, an MCAP file or a rosbag2 SQLite bag (a `.db3` file, or a folder
+    /// with metadata.yaml), recognised by their first bytes.
     /// @throw NotFoundError when it does not exist; FormatError naming the file when it is not a
     /// recording this build reads or its header is damaged; IoError when it cannot be read.
     [[nodiscard]] static std::unique_ptr<Recording> Open(const std::filesystem::path& path);

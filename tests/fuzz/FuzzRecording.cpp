@@ -1,6 +1,7 @@
-// ROS 1 bags (src/recordings/): the container (its index, or a scan of its records when it has
-// none; none, bz2 and lz4 chunks), every message decoded by its type, and the sweeps posed and
-// deskewed as `strata integrate --bag` reads them.
+// Recordings (src/recordings/), ROS 1 bags and MCAP files by their first bytes: the container (its
+// index or summary, or a scan of its records when it has none; every chunk compression), every
+// message decoded by its type, and the sweeps posed and deskewed as `strata integrate --bag`
+// reads them.
 #include "FuzzSupport.hpp"
 #include "strata/recordings/Messages.hpp"
 #include "strata/recordings/RecordedScans.hpp"
@@ -9,7 +10,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace strata;              // NOLINT(google-build-using-namespace): harness
     using namespace strata::recordings;  // NOLINT(google-build-using-namespace)
-    const auto path = fuzz::WriteInput(data, size, "recording.bag");
+    const auto path = fuzz::WriteInput(data, size, "recording");
     const std::string file = path.string();
     fuzz::Refusal([&] {
         const auto bag = Recording::Open(path);
