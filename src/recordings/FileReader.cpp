@@ -15,6 +15,10 @@ void Fail(const std::string& where, const std::string& message) {
     throw FormatError(where + ": " + message);
 }
 
+std::string At(const std::string& file, const char* what, uint64_t offset) {
+    return file + ": " + what + " at byte " + std::to_string(offset);
+}
+
 FileReader::FileReader(const std::filesystem::path& path) : name_(path.string()) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);

@@ -15,6 +15,9 @@ namespace strata::recordings::detail {
 /// @brief Throws FormatError "<where>: <message>".
 [[noreturn]] void Fail(const std::string& where, const std::string& message);
 
+/// @brief "<file>: <what> at byte <offset>", how the container readers name a record in errors.
+[[nodiscard]] std::string At(const std::string& file, const char* what, uint64_t offset);
+
 /// @brief A file read at chosen offsets, never past its end.
 class FileReader {
 public:

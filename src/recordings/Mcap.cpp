@@ -38,10 +38,6 @@ std::string McapString(core::ByteCursor& in, const char* what) {
     return std::string(reinterpret_cast<const char*>(in.Take(n, what)), n);
 }
 
-std::string McapWhere(const std::string& file, const char* what, uint64_t offset) {
-    return file + ": " + what + " at byte " + std::to_string(offset);
-}
-
 // A message record's content: channel, sequence, log time, publish time, then the data.
 constexpr size_t kMessageHeaderBytes = 2 + 4 + 8 + 8;
 
@@ -85,7 +81,7 @@ Mcap::Mcap(const std::filesystem::path& path) : file_(path) {
     }
     const Record header = ReadRecord(sizeof(kMcapMagic), true);
     if (header.op != kHeader)
-        Fail(McapWhere(name, "record", sizeof(kMcapMagic)), "the first record is not the Header");
+        Fail(At(name, "record", sizeof(kMcapMagic)), "the first record is not the Header");
     data_start_ = header.end;
     // The footer and the closing magic: missing when the recorder died (`mcap recover` rewrites
     // such a file), and then refused as truncated.
@@ -175,7 +171,7 @@ void Mcap::ReadSummary(uint64_t start, uint64_t end) {
     bool counted = false;
     for (uint64_t offset = start; offset < end;) {
         const Record r = ReadRecord(offset, true);
-        const std::string where = McapWhere(name, "summary record", offset);
+        const std::string where = At(name, "summary record", offset);
         core::ByteCursor in(r.content.data(), r.content.size(), where);
         if (r.op == kSchema) {
             AddSchema(r.content.data(), r.content.size(), where);
@@ -256,7 +252,7 @@ void Mcap::ScanData(uint64_t end) {
     };
     for (uint64_t offset = data_start_; offset < end;) {
         const Record r = ReadRecord(offset, true);
-        const std::string where = McapWhere(file_.name(), "record", offset);
+        const std::string where = At(file_.name(), "record", offset);
         if (r.op == kDataEnd || r.op == kFooter) break;
         if (r.op == kSchema) {
             AddSchema(r.content.data(), r.content.size(), where);
@@ -295,7 +291,7 @@ void Mcap::ScanData(uint64_t end) {
 
 Mcap::ChunkBytes Mcap::ChunkRecords(uint64_t offset, std::string* compression) const {
     Record r = ReadRecord(offset, true);
-    const std::string where = McapWhere(file_.name(), "chunk", offset);
+    const std::string where = At(file_.name(), "chunk", offset);
     if (r.op != kChunk) Fail(where, "no chunk record starts there");
     core::ByteCursor in(r.content.data(), r.content.size(), where);
     in.Skip(16, "message start and end times");
@@ -347,8 +343,7 @@ void Mcap::Read(const std::vector<std::string>& topics, const Visitor& visit) co
                          [&](uint16_t c) { return wanted.count(c) != 0; })) {
             continue;
         }
-        const std::string where =
-            McapWhere(file_.name(), block.chunk ? "chunk" : "message", block.offset);
+        const std::string where = At(file_.name(), block.chunk ? "chunk" : "message", block.offset);
         if (!block.chunk) {
             const Record r = ReadRecord(block.offset, true);
             const uint16_t channel = ChannelOf(r.content.data(), r.content.size(), where);
@@ -374,7 +369,7 @@ void Mcap::Read(const std::vector<std::string>& topics, const Visitor& visit) co
 }
 
 void Mcap::ReadMessage(const MessageLocation& location, const Visitor& visit) const {
-    const std::string where = McapWhere(file_.name(), "message", location.chunk);
+    const std::string where = At(file_.name(), "message", location.chunk);
     if (location.record == kUnchunked) {
         const Record r = ReadRecord(location.chunk, true);
         if (r.op != kMessage) Fail(where, "no message record starts there");

@@ -80,10 +80,6 @@ int64_t TimeNs(uint64_t packed) {
     return sec * 1000000000 + nsec;
 }
 
-std::string At(const std::string& file, const char* what, uint64_t offset) {
-    return file + ": " + what + " at byte " + std::to_string(offset);
-}
-
 }  // namespace
 
 namespace {
