@@ -106,7 +106,8 @@ std::vector<uint32_t> IdsFromArray(const py::array& ids, size_t count, const cha
 }
 
 core::Scan ScanFromArrays(const py::array& points, const py::array& pose, const py::object& labels,
-                          const py::object& classes) {
+                          const py::object& classes, const py::object& ray_origins,
+                          const py::object& ray_starts) {
     core::Scan scan;
     scan.points = PointsFromArray(points);
     scan.T_world_sensor = PoseFromArray(pose);
@@ -138,7 +139,31 @@ core::Scan ScanFromArrays(const py::array& points, const py::array& pose, const 
             scan.labels.push_back(static_cast<core::SemanticClass>(ids[i]));
         }
     }
+    if (ray_origins.is_none() != ray_starts.is_none()) {
+        throw InvalidArgumentError("give ray_origins and ray_starts together, or neither");
+    }
+    if (!ray_origins.is_none()) {
+        const std::vector<Eigen::Vector3d> origins =
+            PointsFromArray(py::array::ensure(ray_origins), "ray_origins");
+        const std::vector<uint32_t> starts =
+            IdsFromArray(py::array::ensure(ray_starts), origins.size(), "ray_starts");
+        for (size_t r = 0; r < origins.size(); ++r)
+            scan.ray_origins.push_back({starts[r], origins[r]});
+        scan.Validate();  // the runs' order, named in the message
+    }
     return scan;
+}
+
+std::pair<py::object, py::object> RayOriginsToArrays(const core::Scan& scan) {
+    if (scan.ray_origins.empty()) return {py::none(), py::none()};
+    std::vector<Eigen::Vector3d> origins;
+    std::vector<int64_t> starts;
+    for (const core::RayOrigin& r : scan.ray_origins) {
+        origins.push_back(r.origin);
+        starts.push_back(static_cast<int64_t>(r.begin));
+    }
+    const auto n = static_cast<py::ssize_t>(starts.size());
+    return {PointsToArray(origins), ToArray(std::move(starts), {n})};
 }
 
 py::array_t<double> PointsToArray(const std::vector<Eigen::Vector3d>& points) {

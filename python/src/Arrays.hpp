@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "strata/core/Scan.hpp"
@@ -29,9 +30,15 @@ namespace py = pybind11;
 
 /// A scan from arrays: `labels` are SemanticKITTI ids (class | instance << 16, as .label files
 /// and strata.simulate give them), `classes` strata's class ids (as queries give them); at most
-/// one of the two, None for neither.
+/// one of the two, None for neither. `ray_origins` (R, 3) and `ray_starts` (R,), both or
+/// neither: run r's rays start at ray_origins[r] (sensor frame) from point ray_starts[r] on, as
+/// strata.read_bag gives them for deskewed sweeps (core::Scan::ray_origins).
 [[nodiscard]] core::Scan ScanFromArrays(const py::array& points, const py::array& pose,
-                                        const py::object& labels, const py::object& classes);
+                                        const py::object& labels, const py::object& classes,
+                                        const py::object& ray_origins = py::none(),
+                                        const py::object& ray_starts = py::none());
+/// The ray origins of `scan` as (R, 3) origins and (R,) first points; None, None when it has none.
+[[nodiscard]] std::pair<py::object, py::object> RayOriginsToArrays(const core::Scan& scan);
 
 /// A numpy array that takes over `values` (no copy); `shape`'s product must equal its size.
 template <typename T>

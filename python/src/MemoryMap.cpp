@@ -25,13 +25,14 @@ MemoryMap CreateMemoryMap(double voxel, double max_range, double min_range, bool
 }
 
 py::dict IntegrateInMemory(MemoryMap& m, const py::array& points, const py::array& pose,
-                           const py::object& labels, const py::object& classes) {
+                           const py::object& labels, const py::object& classes,
+                           const py::object& ray_origins, const py::object& ray_starts) {
     if (m.read_only) {
         throw InvalidArgumentError(
             "this VoxelMap is a stored map's snapshot; integrate through "
             "Map.session() instead");
     }
-    const core::Scan scan = ScanFromArrays(points, pose, labels, classes);
+    const core::Scan scan = ScanFromArrays(points, pose, labels, classes, ray_origins, ray_starts);
     integration::ScanUpdate update;
     {
         py::gil_scoped_release release;
@@ -90,12 +91,16 @@ A map held in memory: scans integrated from numpy arrays with OctoMap's occupanc
              "An empty map with cubic voxels of `voxel` metres.")
         .def("integrate", &IntegrateInMemory, py::arg("points"), py::arg("pose"),
              py::arg("labels") = py::none(), py::arg("classes") = py::none(),
+             py::arg("ray_origins") = py::none(), py::arg("ray_starts") = py::none(),
              R"doc(Integrates one scan.
 
 points: (N, 3) float32 or float64, sensor frame, metres.
 pose: (4, 4) or (3, 4) sensor-to-map transform.
 labels: optional (N,) SemanticKITTI ids (class | instance << 16); or
 classes: optional (N,) strata class ids (strata.CLASSES).
+ray_origins, ray_starts: optional (R, 3) sensor-frame origins and (R,) first points: the rays
+of points ray_starts[r] up to ray_starts[r + 1] start at ray_origins[r] (a deskewed sweep,
+as strata.read_bag gives it); by default every ray starts at the sensor.
 Returns {"points", "dropped", "clipped"} counts.)doc")
         .def(
             "occupancy",

@@ -36,6 +36,9 @@ py::dict ScanToDict(core::Scan&& scan) {
     out["intensity"] = scan.intensity.empty() ? py::object(py::none())
                                               : py::object(ToArray(std::move(scan.intensity), {n}));
     out["pose"] = MatrixToArray(scan.T_world_sensor.matrix());
+    auto [origins, starts] = RayOriginsToArrays(scan);
+    out["ray_origins"] = std::move(origins);
+    out["ray_starts"] = std::move(starts);
     out["time"] = scan.time_s;
     return out;
 }

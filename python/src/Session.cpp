@@ -33,9 +33,11 @@ public:
     }
 
     py::dict Integrate(const py::array& points, const py::array& pose, const py::object& labels,
-                       const py::object& classes) {
+                       const py::object& classes, const py::object& ray_origins,
+                       const py::object& ray_starts) {
         pipeline::NewSession& session = Writer();
-        const core::Scan scan = ScanFromArrays(points, pose, labels, classes);
+        const core::Scan scan =
+            ScanFromArrays(points, pose, labels, classes, ray_origins, ray_starts);
         integration::ScanUpdate update;
         {
             py::gil_scoped_release release;
@@ -83,7 +85,8 @@ void RegisterSession(py::module_& m) {
         .def(py::init<const StoredMap&, const std::string&, double>(), py::arg("map"),
              py::arg("name"), py::arg("memory_budget_mb") = 0.0)
         .def("integrate", &Session::Integrate, py::arg("points"), py::arg("pose"),
-             py::arg("labels") = py::none(), py::arg("classes") = py::none())
+             py::arg("labels") = py::none(), py::arg("classes") = py::none(),
+             py::arg("ray_origins") = py::none(), py::arg("ray_starts") = py::none())
         .def("commit", &Session::Commit)
         .def("abort", &Session::Abort)
         .def_property_readonly("record", &Session::Record);

@@ -26,7 +26,9 @@ class Scan:
     points: (N, 3) sensor frame, metres; pose: (4, 4) sensor-to-map transform;
     labels: (N,) SemanticKITTI ids (class | instance << 16) or None;
     classes: (N,) strata class ids (index into strata.CLASSES) or None;
-    intensity: (N,) or None; time: seconds.
+    intensity: (N,) or None; time: seconds; ray_origins (R, 3) and ray_starts (R,): where the
+    rays of a deskewed sweep start (run r: points ray_starts[r] up to the next run's start, from
+    ray_origins[r] in the sensor frame), or None when every ray starts at the sensor.
     """
     points: np.ndarray
     pose: np.ndarray
@@ -34,6 +36,8 @@ class Scan:
     classes: Optional[np.ndarray] = None
     intensity: Optional[np.ndarray] = None
     time: float = 0.0
+    ray_origins: Optional[np.ndarray] = None
+    ray_starts: Optional[np.ndarray] = None
 
 
 def read_points(path, bin_fields: int = 0, origin=None) -> Scan:
@@ -70,11 +74,11 @@ def read_bag(path, points_topic: Optional[str] = None, fixed_frame: Optional[str
     the frame of the poses (default: the tf tree's root); odom_topic: a nav_msgs/Odometry topic
     to pose the sweeps by instead of /tf; deskew: move each point by the pose of its own time
     where the clouds carry per-point times; frames: "A:B", the sweeps to read. Each Scan has
-    float64 points in the sensor frame at the sweep's stamp, the pose there, intensity (or None)
-    and the stamp as `time`. The recording is opened (and every refusal raised) at the call;
-    the sweeps are read one at a time as the generator is iterated. To map them:
-    `with m.session("drive") as s: for scan in strata.read_bag(p): s.integrate(scan.points,
-    scan.pose)`.
+    float64 points in the sensor frame at the sweep's stamp, the pose there, intensity (or None),
+    the stamp as `time` and, deskewed, the runs' ray origins. The recording is opened (and every
+    refusal raised) at the call; the sweeps are read one at a time as the generator is iterated.
+    To map them: `with m.session("drive") as s: for scan in strata.read_bag(p):
+    s.integrate(scan)`.
     """
     rec = _strata._Recording(str(path), points_topic or "", fixed_frame or "", odom_topic or "",
                              deskew, frames or "")
@@ -83,7 +87,7 @@ def read_bag(path, points_topic: Optional[str] = None, fixed_frame: Optional[str
         for k in range(len(rec)):
             d = rec.scan(k)
             yield Scan(points=d["points"], pose=d["pose"], intensity=d["intensity"],
-                       time=d["time"])
+                       time=d["time"], ray_origins=d["ray_origins"], ray_starts=d["ray_starts"])
     return sweeps()
 
 
@@ -113,12 +117,22 @@ class Session:
         self._map = map
         self._impl = _strata._Session(map._impl, name, memory_budget_mb)
 
-    def integrate(self, points, pose, labels=None, classes=None) -> dict:
-        """Integrates one scan (see VoxelMap.integrate for the arrays) with the map's
-        integration rule, through the same session writer as `strata integrate`; nothing
-        reaches the map on disk before commit(). Returns {"points", "dropped", "clipped"}.
-        An error about the scan names it ("scan 3 (numpy): ...")."""
-        return self._impl.integrate(points, pose, labels, classes)
+    def integrate(self, points, pose=None, labels=None, classes=None, ray_origins=None,
+                  ray_starts=None) -> dict:
+        """Integrates one scan (see VoxelMap.integrate for the arrays, or give a strata.Scan
+        alone) with the map's integration rule, through the same session writer as
+        `strata integrate`; nothing reaches the map on disk before commit(). Returns
+        {"points", "dropped", "clipped"}. An error about the scan names it
+        ("scan 3 (numpy): ...")."""
+        if isinstance(points, Scan):
+            if pose is not None:
+                raise TypeError("integrate(scan) takes the pose from the Scan")
+            s = points
+            return self._impl.integrate(s.points, s.pose, s.labels, s.classes, s.ray_origins,
+                                        s.ray_starts)
+        if pose is None:
+            raise TypeError("integrate() needs a pose with points (or a strata.Scan alone)")
+        return self._impl.integrate(points, pose, labels, classes, ray_origins, ray_starts)
 
     def commit(self) -> dict:
         """Writes the session in one transaction; returns its record (as Map.sessions())."""

@@ -21,6 +21,15 @@ void Scan::Validate() const {
         throw InvalidArgumentError(where + ": " + std::to_string(intensity.size()) +
                                    " intensities for " + std::to_string(n) + " points");
     }
+    for (size_t r = 0; r < ray_origins.size(); ++r) {
+        const RayOrigin& o = ray_origins[r];
+        const bool ordered = r == 0 ? o.begin == 0 : o.begin > ray_origins[r - 1].begin;
+        if (!ordered || (o.begin >= n && n > 0) || !o.origin.allFinite()) {
+            throw InvalidArgumentError(where + ": ray origin run " + std::to_string(r) +
+                                       " (from point " + std::to_string(o.begin) +
+                                       ") is out of order, past the points or not finite");
+        }
+    }
     if (!T_world_sensor.matrix().allFinite()) {
         throw InvalidArgumentError(where + ": the sensor pose is not finite");
     }

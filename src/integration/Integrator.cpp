@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 #include "ApplyUpdate.hpp"
 #include "RadixSort.hpp"
@@ -20,14 +21,14 @@ namespace {
 // with `offsets`, the point's index rides along so each group also sums its points' offsets
 // from the voxel centre.
 std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
-                                          const core::Scan& scan, bool offsets) {
+                                          const core::SemanticClass* labels, bool offsets) {
     const size_t n = prepared.endpoint_pos.size();
     std::vector<uint64_t> keys(n);
     std::vector<uint32_t> points;
     if (offsets) points.assign(prepared.endpoint_point.begin(), prepared.endpoint_point.end());
     for (size_t i = 0; i < n; ++i) {
-        const auto label = scan.has_labels() ? scan.labels[prepared.endpoint_point[i]]
-                                             : core::SemanticClass::kUnknown;
+        const auto label =
+            labels != nullptr ? labels[prepared.endpoint_point[i]] : core::SemanticClass::kUnknown;
         keys[i] =
             (static_cast<uint64_t>(prepared.endpoint_pos[i]) << 8) | static_cast<uint64_t>(label);
     }
@@ -52,6 +53,71 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
         i = j;
     }
     return groups;
+}
+
+// The update of the rays from one origin (map frame); `labels` is null or one per point.
+ScanUpdate RaysFrom(const std::vector<Eigen::Vector3d>& points_map, const Eigen::Vector3d& origin,
+                    const core::SemanticClass* labels, double voxel_size,
+                    const IntegrationConfig& config) {
+    const detail::PreparedScan prepared =
+        detail::PrepareScan(points_map, origin, voxel_size, config);
+    // Grouping endpoints (serial) runs beside the parallel ray marking.
+    ScanUpdate update;
+    detail::ScanMasks masks;
+    tbb::parallel_invoke(
+        [&] { masks = detail::MarkScan(prepared, config); },
+        [&] { update.endpoints = GroupEndpoints(prepared, labels, config.keep_point_means); });
+    update.free = masks.free;
+    update.occupied = masks.occupied;
+    update.points = points_map.size();
+    update.dropped = prepared.dropped;
+    update.clipped = prepared.clipped;
+    return update;
+}
+
+// A scan whose rays start at several origins: the update of each run of rays, then one update
+// with the semantics of a single origin's (each voxel once, occupied winning over free, one
+// endpoint group per voxel and class).
+ScanUpdate RaysFromEachOrigin(const core::Scan& scan,
+                              const std::vector<Eigen::Vector3d>& points_map,
+                              const Eigen::Isometry3d& T_map_sensor, double voxel_size,
+                              const IntegrationConfig& config) {
+    ScanUpdate all;
+    all.free = std::make_shared<openvdb::MaskTree>();
+    all.occupied = std::make_shared<openvdb::MaskTree>();
+    for (size_t r = 0; r < scan.ray_origins.size(); ++r) {
+        const size_t begin = scan.ray_origins[r].begin;
+        const size_t end =
+            r + 1 < scan.ray_origins.size() ? scan.ray_origins[r + 1].begin : points_map.size();
+        const std::vector<Eigen::Vector3d> run(points_map.begin() + static_cast<ptrdiff_t>(begin),
+                                               points_map.begin() + static_cast<ptrdiff_t>(end));
+        const ScanUpdate part =
+            RaysFrom(run, T_map_sensor * scan.ray_origins[r].origin,
+                     scan.has_labels() ? scan.labels.data() + begin : nullptr, voxel_size, config);
+        all.free->topologyUnion(*part.free);
+        all.occupied->topologyUnion(*part.occupied);
+        all.endpoints.insert(all.endpoints.end(), part.endpoints.begin(), part.endpoints.end());
+        all.points += part.points;
+        all.dropped += part.dropped;
+        all.clipped += part.clipped;
+    }
+    all.free->topologyDifference(*all.occupied);
+    // Coordinates compare as the box index orders them (x, then y, then z).
+    const auto key = [](const EndpointGroup& g) { return std::make_pair(g.ijk, g.label); };
+    std::stable_sort(
+        all.endpoints.begin(), all.endpoints.end(),
+        [&](const EndpointGroup& a, const EndpointGroup& b) { return key(a) < key(b); });
+    std::vector<EndpointGroup> merged;
+    for (const EndpointGroup& g : all.endpoints) {
+        if (!merged.empty() && key(merged.back()) == key(g)) {
+            merged.back().points += g.points;
+            merged.back().offset_sum += g.offset_sum;
+        } else {
+            merged.push_back(g);
+        }
+    }
+    all.endpoints = std::move(merged);
+    return all;
 }
 
 // Refuses an update whose new leaves would grow the map's grids by more than the budget: every
@@ -108,20 +174,15 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                           }
                       });
 
-    const detail::PreparedScan prepared =
-        detail::PrepareScan(points_map, T_map_sensor.translation(), map.voxel_size, config);
-    // Grouping endpoints (serial) runs beside the parallel ray marking.
-    ScanUpdate update;
-    detail::ScanMasks masks;
-    tbb::parallel_invoke(
-        [&] { masks = detail::MarkScan(prepared, config); },
-        [&] { update.endpoints = GroupEndpoints(prepared, scan, config.keep_point_means); });
-    update.free = masks.free;
-    update.occupied = masks.occupied;
+    // Endpoint-only clouds have no rays, so no origins to tell apart.
+    ScanUpdate update =
+        scan.ray_origins.size() > 1 && !config.points_only
+            ? RaysFromEachOrigin(scan, points_map, T_map_sensor, map.voxel_size, config)
+            : RaysFrom(points_map,
+                       T_map_sensor * (scan.ray_origins.empty() ? Eigen::Vector3d::Zero()
+                                                                : scan.ray_origins[0].origin),
+                       scan.has_labels() ? scan.labels.data() : nullptr, map.voxel_size, config);
     RequireUpdateFits(update, map, config);
-    update.points = scan.points.size();
-    update.dropped = prepared.dropped;
-    update.clipped = prepared.clipped;
     return update;
 }
 

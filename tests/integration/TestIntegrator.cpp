@@ -276,6 +276,59 @@ TEST(Integrator, GeoreferencedOriginKeepsPrecision) {
     EXPECT_EQ(ActiveVoxels(*a.free), ActiveVoxels(*b.free));
 }
 
+TEST(Integrator, RaysStartAtTheOriginOfTheirRun) {
+    // 1 m voxels, sensor at (0.5, 0.5, 0.5). Run 0's ray runs along x from the sensor to voxel
+    // 4; run 1's starts 2 m further in y and runs along x too, to (4.5, 2.5, 0.5). From the
+    // sensor that second point's ray would cross (1..3, 1, 0) diagonally instead.
+    core::VoxelMap map = core::VoxelMap::Create(1.0);
+    core::Scan scan = MakeScan({{4.5, 0.5, 0.5}, {4.5, 2.5, 0.5}}, {0.5, 0.5, 0.5});
+    const auto one_origin = ComputeScanUpdate(scan, map, IntegrationConfig{});
+    scan.ray_origins = {{0, Eigen::Vector3d::Zero()}, {1, Eigen::Vector3d(0.0, 2.0, 0.0)}};
+    const auto two_origins = ComputeScanUpdate(scan, map, IntegrationConfig{});
+    EXPECT_EQ(ActiveVoxels(*two_origins.free), (std::set<Key>{{0, 0, 0},
+                                                              {1, 0, 0},
+                                                              {2, 0, 0},
+                                                              {3, 0, 0},  //
+                                                              {0, 2, 0},
+                                                              {1, 2, 0},
+                                                              {2, 2, 0},
+                                                              {3, 2, 0}}));
+    EXPECT_EQ(ActiveVoxels(*two_origins.occupied), (std::set<Key>{{4, 0, 0}, {4, 2, 0}}));
+    EXPECT_EQ(ActiveVoxels(*two_origins.occupied), ActiveVoxels(*one_origin.occupied));
+    EXPECT_EQ(ActiveVoxels(*one_origin.free).count({1, 2, 0}), 0u);
+    EXPECT_EQ(two_origins.points, 2u);
+}
+
+TEST(Integrator, SeveralOriginsKeepOneScansSemantics) {
+    // The room seen from two origins in two runs: the update is the union of the two runs'
+    // updates with occupied winning, and one endpoint group per voxel and class across runs.
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    const core::Scan a = RoomScan(5, 3000), b = RoomScan(6, 3000);
+    core::Scan both = a;
+    for (const Eigen::Vector3d& p : b.points) both.points.push_back(p + Eigen::Vector3d(0.3, 0, 0));
+    both.ray_origins = {{0, Eigen::Vector3d::Zero()}, {a.points.size(), {0.3, 0.0, 0.0}}};
+    core::Scan b_moved = b;
+    b_moved.T_world_sensor.translate(Eigen::Vector3d(0.3, 0.0, 0.0));
+    const auto u = ComputeScanUpdate(both, map, IntegrationConfig{});
+    const auto ua = ComputeScanUpdate(a, map, IntegrationConfig{});
+    const auto ub = ComputeScanUpdate(b_moved, map, IntegrationConfig{});
+    std::set<Key> occupied = ActiveVoxels(*ua.occupied), free = ActiveVoxels(*ua.free);
+    for (const Key& k : ActiveVoxels(*ub.occupied)) occupied.insert(k);
+    for (const Key& k : ActiveVoxels(*ub.free)) free.insert(k);
+    for (const Key& k : occupied) free.erase(k);
+    EXPECT_EQ(ActiveVoxels(*u.occupied), occupied);
+    EXPECT_EQ(ActiveVoxels(*u.free), free);
+    ASSERT_EQ(u.endpoints.size(), occupied.size());  // one class: one group per voxel
+    int32_t points = 0;
+    for (size_t i = 0; i < u.endpoints.size(); ++i) {
+        points += u.endpoints[i].points;
+        if (i > 0) {
+            EXPECT_TRUE(u.endpoints[i - 1].ijk < u.endpoints[i].ijk);
+        }
+    }
+    EXPECT_EQ(points, static_cast<int32_t>(both.points.size()));
+}
+
 TEST(Integrator, RejectsBadConfigAndMismatchedLabels) {
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     IntegrationConfig bad;
@@ -283,6 +336,11 @@ TEST(Integrator, RejectsBadConfigAndMismatchedLabels) {
     EXPECT_THROW(Integrator(map, bad), InvalidArgumentError);
     core::Scan scan = RoomScan(1, 10);
     scan.labels.resize(3);
+    EXPECT_THROW((void)ComputeScanUpdate(scan, map, IntegrationConfig{}), InvalidArgumentError);
+    scan.labels.clear();
+    scan.ray_origins = {{1, Eigen::Vector3d::Zero()}};  // the first run must begin at point 0
+    EXPECT_THROW((void)ComputeScanUpdate(scan, map, IntegrationConfig{}), InvalidArgumentError);
+    scan.ray_origins = {{0, Eigen::Vector3d::Zero()}, {0, Eigen::Vector3d::Zero()}};
     EXPECT_THROW((void)ComputeScanUpdate(scan, map, IntegrationConfig{}), InvalidArgumentError);
 }
 

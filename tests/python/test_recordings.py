@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import strata
-from conftest import SOURCE_DIR
+from conftest import SOURCE_DIR, run_strata
 
 WRITER = SOURCE_DIR / "tests" / "recordings" / "write_ros1_bag.py"
 
@@ -48,14 +48,46 @@ def test_read_bag_yields_the_scans_and_poses_written(tmp_path):
     assert len(list(strata.read_bag(tmp_path / "drive.bag", frames="1:"))) == 2
 
 
+def moving_bag(tmp_path):
+    """The box's three scans recorded while driving 1 m along x during each 0.1 s sweep (each
+    point's time in Velodyne's `time` field, /tf at 20 poses a sweep): deskewed, their rays
+    start at ray origins of their own."""
+    poses = kitti_folder(tmp_path / "seq")
+    rng = np.random.default_rng(4)
+    with open(tmp_path / "seq" / "times.txt", "w") as f:
+        f.write("".join(f"{0.1 * k}\n" for k in range(len(poses))))
+    with open(tmp_path / "end_poses.txt", "w") as f:
+        for k, pose in enumerate(poses):
+            rng.uniform(0, 0.1, 2000).astype(np.float32).tofile(
+                tmp_path / "seq" / "velodyne" / f"{k:06d}.time")
+            end = pose.copy()
+            end[0, 3] += 1.0
+            f.write(" ".join(f"{v:.17g}" for v in end[:3].ravel()) + "\n")
+    write_bag(tmp_path / "seq", tmp_path / "drive.bag", "--point-time", "time", "--tf-rate",
+              "20", "--motion", tmp_path / "end_poses.txt")
+    return tmp_path / "drive.bag"
+
+
 def test_a_session_integrates_a_bag_as_the_program_does(tmp_path):
-    kitti_folder(tmp_path / "seq")
-    write_bag(tmp_path / "seq", tmp_path / "drive.bag")
-    with strata.Map.create(tmp_path / "map.strata", voxel=0.1) as m:
-        with m.session("drive") as s:
-            for scan in strata.read_bag(tmp_path / "drive.bag"):
-                s.integrate(scan.points, scan.pose)
-        assert [r["scans"] for r in m.sessions()] == [3]
+    bag = moving_bag(tmp_path)
+    run_strata("integrate", tmp_path / "cli.strata", "--voxel", 0.1, "--bag", bag)
+    scans = list(strata.read_bag(bag))
+    assert all(len(scan.ray_origins) > 2 and scan.ray_starts[0] == 0 for scan in scans)
+    for name, rays in (("py.strata", True), ("one_origin.strata", False)):
+        with strata.Map.create(tmp_path / name, voxel=0.1) as m:
+            with m.session("drive") as s:
+                for scan in scans:
+                    s.integrate(scan) if rays else s.integrate(scan.points, scan.pose)
+            assert [r["scans"] for r in m.sessions()] == [3]
+    box = ([-4, -3, -2], [6, 3, 2])
+    with strata.Map.open(tmp_path / "cli.strata", read_only=True) as cli:
+        theirs = cli.voxels(*box)
+    for name, same in (("py.strata", True), ("one_origin.strata", False)):
+        with strata.Map.open(tmp_path / name, read_only=True) as m:
+            ours = m.voxels(*box)
+        identical = (np.array_equal(ours["ijk"], theirs["ijk"]) and
+                     np.array_equal(ours["log_odds"], theirs["log_odds"]))
+        assert identical == same, name
 
 
 def test_read_bag_refusals_have_their_kinds(tmp_path):

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -8,6 +9,14 @@
 #include "strata/core/Labels.hpp"
 
 namespace strata::core {
+
+/// @brief Where the rays of a run of a scan's points start, when the sensor moved during the sweep
+/// (a deskewed sweep, docs/recordings.md): the points from `begin` up to the next run's `begin`
+/// were measured from `origin`, in the sensor frame of the scan's pose.
+struct RayOrigin {
+    size_t begin = 0;
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+};
 
 /// @brief One LiDAR sweep: points in the sensor frame, optional per-point data, and the sensor
 /// pose.
@@ -19,12 +28,15 @@ struct Scan {
     std::vector<uint16_t> instances;      ///< optional instance ids (SemanticKITTI upper 16 bits)
     std::vector<float> intensity;         ///< optional, as the source stores it
     Eigen::Isometry3d T_world_sensor = Eigen::Isometry3d::Identity();
+    /// Optional: empty when every ray starts at the sensor's origin (0, 0, 0); else the first
+    /// run begins at point 0 and the runs' `begin`s increase.
+    std::vector<RayOrigin> ray_origins;
     double time_s = 0.0;
     std::string source;  ///< file the scan came from, for error messages and the catalog
 
     [[nodiscard]] bool has_labels() const { return !labels.empty(); }
-    /// @brief Throws InvalidArgumentError (naming `source`) when per-point arrays disagree in size
-    /// or the pose is not finite.
+    /// @brief Throws InvalidArgumentError (naming `source`) when per-point arrays disagree in size,
+    /// the ray origins are out of order or not finite, or the pose is not finite.
     void Validate() const;
 };
 

@@ -45,7 +45,8 @@ public:
 
     /// @brief Sweep `i` in the sensor's frame at its stamp, posed there (`T_world_sensor` is the
     /// sensor in the fixed frame). Deskewed: each point moved by the pose of its own instant into
-    /// the frame of the stamp's.
+    /// the frame of the stamp's, and the points ordered into runs whose rays start where the
+    /// sensor was during the run (`ray_origins`, within 2.5 cm of the true origin).
     /// @throw RefusedError when a point's time lies outside the trajectory; FormatError for a
     /// damaged message.
     [[nodiscard]] core::Scan Read(size_t i) const;
