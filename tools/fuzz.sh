@@ -31,8 +31,9 @@ echo "fuzz.sh: build took $(($(date +%s) - start)) s"
 rm -rf "$build/seeds"
 "$build/tests/fuzz/fuzz_make_corpus" "$build/seeds"
 # Seed recordings by independent writers (tools/setup.sh installs them): ROS 1 bags by Debian's
-# python3-rosbag, MCAP files by @mcap/core, in each compression, with per-point times and poses
-# denser than the sweeps.
+# python3-rosbag, MCAP files by @mcap/core, in each compression, and a rosbag2 .db3 by Python's
+# sqlite3 from @foxglove/rosmsg2-serialization's CDR, with per-point times and poses denser than
+# the sweeps.
 mkdir -p "$build/seeds/recording"
 for c in none bz2 lz4; do
   /usr/bin/python3 "$root/tests/recordings/write_ros1_bag.py" "$build/seeds/_recording_seq" \
@@ -43,6 +44,15 @@ for c in none lz4 zstd; do
     "$build/seeds/_recording_seq" "$build/seeds/recording/$c.mcap" --compression "$c" \
     --chunk-kb 1 --point-time t --tf-rate 3
 done
+NODE_PATH="$root/build-deps/npm/node_modules" node "$root/tests/recordings/write_mcap.mjs" \
+  "$build/seeds/_recording_seq" "$build/seeds/_recording.mcap" --point-time t --tf-rate 3 \
+  --dump "$build/seeds/_recording_cdr"
+/usr/bin/python3 "$root/tests/recordings/write_db3.py" "$build/seeds/_recording_cdr" \
+  "$build/seeds/_recording_db3"
+# 512-byte pages (VACUUM by the same sqlite3) bring it from 20 KB to 5 KB, under max_len.
+/usr/bin/python3 -c 'import sqlite3, sys; c = sqlite3.connect(sys.argv[1], isolation_level=None)
+c.execute("PRAGMA page_size=512"); c.execute("VACUUM")' "$build/seeds/_recording_db3/bag_0.db3"
+cp "$build/seeds/_recording_db3/bag_0.db3" "$build/seeds/recording/bag.db3"
 mkdir -p "$build/corpus" "$build/artifacts" "$build/logs"
 
 # Leak checking is off: OpenVDB and TBB keep process-lifetime allocations that are not bugs.

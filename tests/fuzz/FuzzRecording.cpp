@@ -1,7 +1,7 @@
-// Recordings (src/recordings/), ROS 1 bags and MCAP files by their first bytes: the container (its
-// index or summary, or a scan of its records when it has none; every chunk compression), every
-// message decoded by its type, and the sweeps posed and deskewed as `strata integrate --bag`
-// reads them.
+// Recordings (src/recordings/), ROS 1 bags, MCAP files and rosbag2 .db3 files by their first
+// bytes: the container (its index or summary, or a scan of its records when it has none; every
+// chunk compression; SQLite's tables), every message decoded by its type, and the sweeps posed
+// and deskewed as `strata integrate --bag` reads them.
 #include "FuzzSupport.hpp"
 #include "strata/recordings/Messages.hpp"
 #include "strata/recordings/RecordedScans.hpp"
