@@ -93,6 +93,44 @@ void DecompressZstd(const uint8_t* data, size_t size, size_t expected, std::vect
     }
 }
 
+bool IsZstdFrame(const uint8_t* data, size_t size) {
+    static constexpr uint8_t kMagic[4] = {0x28, 0xB5, 0x2F, 0xFD};  // 0xFD2FB528, little-endian
+    return size >= 4 && std::equal(kMagic, kMagic + 4, data);
+}
+
+void DecompressZstdFrame(const uint8_t* data, size_t size, std::vector<uint8_t>& out,
+                         const std::string& where) {
+    const unsigned long long declared = ZSTD_getFrameContentSize(data, size);
+    if (declared == ZSTD_CONTENTSIZE_ERROR) Fail(where, "damaged zstd frame header");
+    if (declared != ZSTD_CONTENTSIZE_UNKNOWN) {
+        CheckDeclaredSize(size, declared, where);
+        DecompressZstd(data, size, static_cast<size_t>(declared), out, where);
+        return;
+    }
+    const size_t most = std::max<size_t>(size_t{1} << 20, size * 2000);
+    const std::unique_ptr<ZSTD_DStream, size_t (*)(ZSTD_DStream*)> stream(ZSTD_createDStream(),
+                                                                          ZSTD_freeDStream);
+    if (!stream) Fail(where, "out of memory for zstd");
+    ZSTD_inBuffer in{data, size, 0};
+    out.resize(std::max<size_t>(size * 4, 4096));
+    ZSTD_outBuffer dst{out.data(), out.size(), 0};
+    for (;;) {
+        const size_t left = ZSTD_decompressStream(stream.get(), &dst, &in);
+        if (ZSTD_isError(left))
+            Fail(where, std::string("damaged zstd frame: ") + ZSTD_getErrorName(left));
+        if (left == 0) break;  // the frame's end
+        if (in.pos == in.size && dst.pos < dst.size) Fail(where, "zstd frame cut short");
+        if (dst.pos == dst.size) {
+            if (out.size() >= most)
+                Fail(where, "zstd frame decompresses to more than 2000x its size");
+            out.resize(std::min(most, out.size() * 2));
+            dst.dst = out.data();
+            dst.size = out.size();
+        }
+    }
+    out.resize(dst.pos);
+}
+
 uint32_t Crc32(const uint8_t* data, size_t size) {
     uLong crc = crc32(0L, Z_NULL, 0);
     while (size > 0) {  // zlib takes 32-bit lengths

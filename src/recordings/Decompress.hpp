@@ -26,6 +26,14 @@ void DecompressLz4Frame(const uint8_t* data, size_t size, size_t expected,
 void DecompressZstd(const uint8_t* data, size_t size, size_t expected, std::vector<uint8_t>& out,
                     const std::string& where);
 
+/// @brief True when `data` begins with a Zstandard frame's magic number.
+[[nodiscard]] bool IsZstdFrame(const uint8_t* data, size_t size);
+/// @brief One Zstandard frame whose size only its header may tell (rosbag2 compresses each
+/// message as one): to the size it declares (CheckDeclaredSize's refusals apply), or, for a frame
+/// written as a stream without one, to its end, at most 2000 times its compressed size.
+void DecompressZstdFrame(const uint8_t* data, size_t size, std::vector<uint8_t>& out,
+                         const std::string& where);
+
 /// @brief The CRC-32 (ISO-HDLC, as zlib computes it) of `size` bytes.
 [[nodiscard]] uint32_t Crc32(const uint8_t* data, size_t size);
 

@@ -1,6 +1,7 @@
 // rosbag2's SQLite storage: each .db3 file has a `topics` table (id, name, type,
 // serialization_format, ...) and a `messages` table (id, topic_id, timestamp in ns, data: the
-// serialized message, CDR for ROS 2). A bag folder lists its files in metadata.yaml
+// serialized message, CDR for ROS 2, or that compressed by zstd in compression_mode MESSAGE). A bag
+// folder lists its files in metadata.yaml
 // (`relative_file_paths`); they are read in that order. Files are opened read-only and
 // immutable, so a bag on a read-only medium reads, and no journal is written beside it.
 #include "Rosbag2Sqlite.hpp"
@@ -8,10 +9,12 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <set>
 #include <sstream>
 
+#include "Decompress.hpp"
 #include "FileReader.hpp"
 #include "strata/core/Error.hpp"
 
@@ -65,6 +68,44 @@ std::vector<std::filesystem::path> BagFiles(const std::filesystem::path& dir) {
     return files;
 }
 
+// The value of `key:` in a bag folder's metadata.yaml (the first line that has it, quotes
+// dropped), or empty.
+std::string MetadataField(const std::filesystem::path& metadata, const std::string& key) {
+    std::ifstream in(metadata);
+    for (std::string line; std::getline(in, line);) {
+        const size_t at = line.find_first_not_of(' ');
+        if (at == std::string::npos || line.compare(at, key.size() + 1, key + ":") != 0) continue;
+        std::string value = line.substr(at + key.size() + 1);
+        value.erase(value.find_last_not_of(" \r\"'") + 1);
+        value.erase(0, value.find_first_not_of(" \"'"));
+        return value;
+    }
+    return {};
+}
+
+// rosbag2's compression as the folder's metadata.yaml declares it: none, or zstd on each message
+// (read here); a whole file compressed (FILE mode, `bag_0.db3.zstd`) cannot be opened by SQLite
+// and is refused with what to do.
+std::string Compression(const std::filesystem::path& dir) {
+    const std::filesystem::path metadata = dir / "metadata.yaml";
+    if (!std::filesystem::exists(metadata)) return "none";
+    std::string mode = MetadataField(metadata, "compression_mode");
+    const std::string format = MetadataField(metadata, "compression_format");
+    std::transform(mode.begin(), mode.end(), mode.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    if (mode.empty() || mode == "NONE") return "none";
+    if (mode == "FILE") {
+        Fail(metadata.string(), "its files are compressed whole (compression_mode FILE, " + format +
+                                    "): decompress each (zstd -d FILE.db3.zstd) and list the "
+                                    ".db3 files in relative_file_paths");
+    }
+    if (mode != "MESSAGE" || format != "zstd") {
+        Fail(metadata.string(), "compression " + format + " in mode " + mode +
+                                    " (strata reads zstd on each message, or none)");
+    }
+    return "zstd (each message)";
+}
+
 // A prepared statement, finalized when it goes.
 class Statement {
 public:
@@ -103,6 +144,17 @@ private:
 
 }  // namespace
 
+const uint8_t* Rosbag2Sqlite::Payload(const uint8_t* data, size_t* size,
+                                      const std::string& file) const {
+    // A CDR message begins with its encapsulation header (0x00 0x00 or 0x00 0x01), never with
+    // zstd's magic, so a compressed message is known by its first bytes, declared or not.
+    if (data == nullptr || !IsZstdFrame(data, *size)) return data;
+    const std::string where = file + ": a zstd-compressed message";
+    DecompressZstdFrame(data, *size, buffer_, where);
+    *size = buffer_.size();
+    return buffer_.data();
+}
+
 uint32_t Rosbag2Sqlite::Stream(size_t file, int64_t topic_id) {
     return static_cast<uint32_t>(file << kTopicBits) | static_cast<uint32_t>(topic_id);
 }
@@ -110,7 +162,7 @@ uint32_t Rosbag2Sqlite::Stream(size_t file, int64_t topic_id) {
 Rosbag2Sqlite::Rosbag2Sqlite(const std::filesystem::path& path) {
     info_.path = path;
     info_.format = "rosbag2 SQLite";
-    info_.compression = "none";
+    info_.compression = std::filesystem::is_directory(path) ? Compression(path) : "none";
     const std::vector<std::filesystem::path> paths =
         std::filesystem::is_directory(path) ? BagFiles(path) : std::vector{path};
     if (paths.size() >= (size_t{1} << (32 - kTopicBits))) Fail(path.string(), "too many files");
@@ -171,7 +223,7 @@ void Rosbag2Sqlite::Read(const std::vector<std::string>& topics, const Visitor& 
             const uint32_t stream = Stream(f, rows.Int(0));
             if (wanted.count(stream) == 0) continue;
             size_t size = 0;
-            const uint8_t* data = rows.Blob(2, &size);
+            const uint8_t* data = Payload(rows.Blob(2, &size), &size, files_[f].name);
             visit(Message{topics_.TopicOf(stream, info_), rows.Int(1), data, size,
                           MessageLocation{f, static_cast<uint64_t>(rows.Int(3))}});
         }
@@ -186,7 +238,7 @@ void Rosbag2Sqlite::ReadMessage(const MessageLocation& location, const Visitor& 
     row.Bind(1, static_cast<int64_t>(location.record));
     if (!row.Step()) Fail(d.name, "no message " + std::to_string(location.record));
     size_t size = 0;
-    const uint8_t* data = row.Blob(2, &size);
+    const uint8_t* data = Payload(row.Blob(2, &size), &size, d.name);
     const Topic* topic = topics_.TopicOf(Stream(location.chunk, row.Int(0)), info_);
     if (topic == nullptr) Fail(d.name, "a message of an undeclared topic");
     visit(Message{topic, row.Int(1), data, size, location});

@@ -32,11 +32,15 @@ private:
     };
     // A stream of TopicTable: the file's index and its topic id.
     static uint32_t Stream(size_t file, int64_t topic_id);
+    // A message's CDR bytes: `data` itself, or decompressed into buffer_ when zstd-compressed
+    // (`size` updated). Called under mutex_; valid until the next call.
+    const uint8_t* Payload(const uint8_t* data, size_t* size, const std::string& file) const;
 
     std::vector<Database> files_;
     RecordingInfo info_;
     TopicTable topics_;
-    mutable std::mutex mutex_;  // one statement at a time on a connection
+    mutable std::mutex mutex_;             // one statement at a time on a connection
+    mutable std::vector<uint8_t> buffer_;  // a decompressed message
 };
 
 }  // namespace strata::recordings::detail

@@ -52,6 +52,26 @@ TEST(Rosbag2, ReadsWhatSqliteWroteInOneFileOrSplit) {
     }
 }
 
+TEST(Rosbag2, ReadsMessagesCompressedByZstdAndRefusesWholeFilesCompressed) {
+    // compression_mode MESSAGE: the zstd program compressed each message's CDR bytes.
+    const fs::path bag = WriteDb3(RoomSequence(), "db3_zstd", "--compress message");
+    const auto recording = Recording::Open(bag);
+    EXPECT_EQ(recording->info().compression, "zstd (each message)");
+    const io::KittiSequence seq = io::OpenKittiSequence(RoomSequence());
+    const RecordedScans scans = RecordedScans::Open(bag, {});
+    ASSERT_EQ(scans.size(), 3u);
+    for (size_t i = 0; i < scans.size(); ++i) {
+        const core::Scan ours = scans.Read(i), kitti = io::ReadKittiScan(seq, i);
+        EXPECT_TRUE(ours.points == kitti.points);
+        EXPECT_TRUE(ours.T_world_sensor.matrix().isApprox(kitti.T_world_sensor.matrix(), 1e-9));
+    }
+    // compression_mode FILE: bag_0.db3.zstd, which SQLite cannot open; the refusal says what to do.
+    const fs::path whole = WriteDb3(RoomSequence(), "db3_zstd_file", "--compress file");
+    const std::string refusal = Refusal<FormatError>([&] { (void)Recording::Open(whole); });
+    EXPECT_NE(refusal.find("metadata.yaml"), std::string::npos) << refusal;
+    EXPECT_NE(refusal.find("zstd -d"), std::string::npos) << refusal;
+}
+
 TEST(Rosbag2, BrokenBagsAreRefusedNamingTheFile) {
     const fs::path bag = WriteDb3(RoomSequence(), "db3_broken");
     // A .db3 file cut in half.

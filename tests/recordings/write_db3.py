@@ -4,12 +4,17 @@
 bytes come from @foxglove/rosmsg2-serialization, the database from Python's sqlite3. Nothing of
 strata is used.
 
-  write_db3.py DUMP OUT_DIR [--split N]   (--split: a new .db3 file every N messages)
+  write_db3.py DUMP OUT_DIR [--split N] [--compress message|file]
+    --split: a new .db3 file every N messages
+    --compress: zstd as `ros2 bag record --compression-format zstd` does it, by the zstd
+      program: each message's data (compression_mode MESSAGE) or each whole file (FILE, the
+      files then named .db3.zstd)
 """
 import argparse
 import json
 import os
 import sqlite3
+import subprocess
 
 SCHEMA = """
 CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);
@@ -26,12 +31,13 @@ def main():
     ap.add_argument('dump')
     ap.add_argument('out')
     ap.add_argument('--split', type=int, default=0)
+    ap.add_argument('--compress', choices=['message', 'file'])
     args = ap.parse_args()
     with open(os.path.join(args.dump, 'messages.jsonl')) as f:
         messages = [json.loads(line) for line in f if line.strip()]
     os.makedirs(args.out, exist_ok=True)
     per_file = args.split or len(messages)
-    files, counts = [], {}
+    files, counts, counts_total = [], {}, 0
     for start in range(0, len(messages), per_file):
         name = 'bag_%d.db3' % len(files)
         files.append(name)
@@ -46,11 +52,22 @@ def main():
                            (topic_ids[m['topic']], m['topic'], m['type'], 'cdr', ''))
             with open(os.path.join(args.dump, m['file']), 'rb') as f:
                 data = f.read()
+            if args.compress == 'message':
+                # rosbag2's compressor declares each frame's size; a streamed frame does not:
+                # every other message is written each way, so readers meet both.
+                declared = ['--stream-size=%d' % len(data)] if counts_total % 2 == 0 else []
+                data = subprocess.run(['zstd', '-q', '-c'] + declared, input=data,
+                                      stdout=subprocess.PIPE, check=True).stdout
+            counts_total += 1
             db.execute('INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)',
                        (topic_ids[m['topic']], int(m['t']), data))
             counts[(m['topic'], m['type'])] = counts.get((m['topic'], m['type']), 0) + 1
         db.commit()
         db.close()
+        if args.compress == 'file':
+            path = os.path.join(args.out, name)
+            subprocess.run(['zstd', '-q', '--rm', path, '-o', path + '.zstd'], check=True)
+            files[-1] = name + '.zstd'
     times = [int(m['t']) for m in messages]
     with open(os.path.join(args.out, 'metadata.yaml'), 'w') as f:
         f.write('rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n')
@@ -61,7 +78,12 @@ def main():
             f.write('    - topic_metadata:\n        name: %s\n        type: %s\n'
                     '        serialization_format: cdr\n        offered_qos_profiles: ""\n'
                     '      message_count: %d\n' % (topic, type_, n))
-        f.write('  compression_format: ""\n  compression_mode: ""\n  relative_file_paths:\n')
+        if args.compress:
+            f.write('  compression_format: zstd\n  compression_mode: %s\n'
+                    % args.compress.upper())
+        else:
+            f.write('  compression_format: ""\n  compression_mode: ""\n')
+        f.write('  relative_file_paths:\n')
         for name in files:
             f.write('    - %s\n' % name)
         f.write('  files:\n')
