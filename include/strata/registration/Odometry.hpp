@@ -1,0 +1,100 @@
+#pragma once
+// LiDAR odometry: poses for scans that came without them, each scan registered to a local map of
+// the scans before it (docs/odometry.md).
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace strata::registration {
+
+/// @brief How the odometry registers scans and keeps its local map (docs/odometry.md, "Method").
+struct OdometryConfig {
+    /// Cell of the local map, metres. A scan joins the map thinned to one point per half cell and
+    /// is registered thinned to one per 1.5 cells.
+    double voxel_m = 1.0;
+    /// Points a map cell keeps (the first that arrive); a full cell takes no more.
+    int max_points_per_voxel = 20;
+    /// Returns closer than this are the vehicle itself and are dropped.
+    double min_range_m = 3.0;
+    /// Returns farther than this are dropped, and map cells this far from the sensor leave the
+    /// local map, so its size (and a scan's cost) stays flat however long the drive.
+    double max_range_m = 100.0;
+    /// The motion model's deviation before it has samples; points are matched within three
+    /// deviations and at most one cell.
+    double initial_threshold_m = 2.0;
+    /// Deviations of a scan from the motion model's prediction below this do not adapt the
+    /// correspondence distance (a vehicle standing still).
+    double min_motion_m = 0.1;
+    /// Gauss-Newton iterations per scan, and the update (metres plus radians) that ends them.
+    int max_iterations = 50;
+    double convergence = 1e-4;
+    /// A scan with fewer matched points than this, or a smaller share of its points matched, is
+    /// refused (too little overlap with the map).
+    int min_correspondences = 100;
+    double min_overlap = 0.2;
+    /// The map around a cell (its points and its 26 neighbours') is a line when the middle
+    /// eigenvalue of their covariance is below this share of the largest, else a plane when the
+    /// smallest is below this share of the middle one. A scan's point whose nearest map point
+    /// lies in a plane's cell is matched to that plane, in an upright line's to that line (the
+    /// distance across either); other points are not matched.
+    double max_planarity_ratio = 0.1;
+
+    /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
+    void Validate() const;
+};
+
+/// @brief What registering one scan found.
+struct OdometryStep {
+    Eigen::Isometry3d T_world_sensor = Eigen::Isometry3d::Identity();
+    /// False when the scan was refused; `failure` says why and `T_world_sensor` is the motion
+    /// model's prediction.
+    bool registered = false;
+    std::string failure;
+    size_t points = 0;           ///< registered (thinned) points
+    size_t correspondences = 0;  ///< of those, matched at the end
+    double rmse_m = 0.0;         ///< of the matched residuals
+    double threshold_m = 0.0;    ///< the correspondence distance used
+    int iterations = 0;
+    /// The smallest eigenvalue of the last step's normal equations per unit of match weight
+    /// (rotations scaled to metres at the points' distance): near zero along a direction the
+    /// geometry does not constrain, which then keeps the prediction.
+    double min_eigenvalue = 0.0;
+};
+
+/// @brief Scan-to-map odometry with a constant-velocity prediction, an adaptive correspondence
+/// distance and a robust kernel; the first scan defines the world frame.
+class Odometry {
+public:
+    explicit Odometry(const OdometryConfig& config = {},
+                      const Eigen::Isometry3d& T_world_first = Eigen::Isometry3d::Identity());
+    ~Odometry();
+    Odometry(Odometry&&) noexcept;
+    Odometry& operator=(Odometry&&) noexcept;
+
+    /// @brief Registers the next scan (points in the sensor frame, metres). A registered scan
+    /// joins the map and the motion model; a refused one changes neither (the caller skips it or
+    /// stops). Never throws for a scan it cannot register.
+    OdometryStep Register(const std::vector<Eigen::Vector3d>& points);
+    /// @brief The same from `guess` instead of the motion model's prediction (a session's first
+    /// scan placed in an existing map, say).
+    OdometryStep Register(const std::vector<Eigen::Vector3d>& points,
+                          const Eigen::Isometry3d& guess);
+    /// @brief Adds points (world frame) to the local map without a pose: an existing map's
+    /// surface around where a session starts.
+    void AddToMap(const std::vector<Eigen::Vector3d>& points_world);
+
+    /// @brief The poses of the registered scans, in order.
+    [[nodiscard]] const std::vector<Eigen::Isometry3d>& poses() const;
+    /// @brief Cells and points in the local map now.
+    [[nodiscard]] size_t map_cells() const;
+    [[nodiscard]] size_t map_points() const;
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+}  // namespace strata::registration

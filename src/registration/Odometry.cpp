@@ -1,0 +1,304 @@
+// Scan-to-map odometry (docs/odometry.md, "Method"): a constant-velocity prediction, then
+// Gauss-Newton on the distance of each point to the map's plane, line or point around its nearest
+// map point, under a Geman-McClure kernel, with the correspondence distance adapted to how far
+// scans deviate from the prediction; the registered scan then joins a local map that forgets what
+// lies beyond the sensor's range.
+#include "strata/registration/Odometry.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "LocalMap.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/registration/Surface.hpp"
+
+namespace strata::registration {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+constexpr double kMapThinning = 0.5;     // a scan joins the map at one point per half cell
+constexpr double kSourceThinning = 1.5;  // and is registered at one per 1.5 cells
+constexpr size_t kPointGrain = 256;      // fixed, so the sums do not depend on thread count
+// Directions whose eigenvalue per unit of match weight is below this are left to the prediction:
+// a plane matched from every point constrains its normal direction with 1.
+constexpr double kMinEigenvalue = 0.002;
+// A line of map points within 45 degrees of the vertical is a pole, a trunk or an upright edge;
+// a flatter one is mostly one ring of the sensor's returns on the ground, which moves with the
+// sensor and would hold it back, and is not matched. (The world's z is the first scan's: a
+// sensor mounted level.)
+const double kMinLineZ = std::sqrt(0.5);
+
+// The normal equations of one Gauss-Newton step, summed over the matched points.
+struct Equations {
+    Matrix6d H = Matrix6d::Zero();
+    Vector6d g = Vector6d::Zero();
+    size_t matched = 0;
+    double squared = 0.0;  // sum of squared residual norms
+    double weight = 0.0;   // sum of the kernel's weights
+    double arms = 0.0;     // sum of the matched points' squared distances from the sensor
+
+    template <int Rows>
+    void Add(const Eigen::Matrix<double, Rows, 6>& J, const Eigen::Matrix<double, Rows, 1>& r,
+             double w) {
+        H.noalias() += w * J.transpose() * J;
+        g.noalias() += w * J.transpose() * r;
+        ++matched;
+        squared += r.squaredNorm();
+        weight += w;
+    }
+    void Join(const Equations& o) {
+        H += o.H;
+        g += o.g;
+        matched += o.matched;
+        squared += o.squared;
+        weight += o.weight;
+        arms += o.arms;
+    }
+};
+
+// Geman-McClure's weight for a squared residual, scale `kernel` (metres).
+double Weight(double r2, double kernel) {
+    const double k2 = kernel * kernel;
+    return k2 / ((kernel + r2) * (kernel + r2));
+}
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+    Eigen::Matrix3d m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+}
+
+// The Gauss-Newton update of `e`, left out along the directions the matches do not constrain:
+// there the prediction stands (a street whose only surfaces run along it says nothing about
+// motion along it). The rotation columns are scaled by the matched points' RMS distance from the
+// sensor, so that both kinds of motion are metres; a direction is unconstrained when its
+// eigenvalue per unit of match weight is below `min_eigenvalue`. Returns the smallest such
+// eigenvalue.
+double SolveConstrained(const Equations& e, double arm_m, double min_eigenvalue, Vector6d* dx) {
+    Vector6d scale;
+    scale << 1, 1, 1, 1.0 / arm_m, 1.0 / arm_m, 1.0 / arm_m;
+    const Matrix6d H = scale.asDiagonal() * e.H * scale.asDiagonal() / e.weight;
+    const Vector6d g = scale.asDiagonal() * e.g / e.weight;
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(H);
+    Vector6d step = Vector6d::Zero();
+    for (int i = 0; i < 6; ++i) {
+        const double lambda = eigen.eigenvalues()(i);
+        if (lambda < min_eigenvalue) continue;
+        const Vector6d v = eigen.eigenvectors().col(i);
+        step -= (v.dot(g) / lambda) * v;
+    }
+    *dx = scale.asDiagonal() * step;
+    return eigen.eigenvalues()(0);
+}
+
+// The rigid motion of a small update (translation, rotation vector), applied on the left.
+Eigen::Isometry3d Exp(const Vector6d& dx) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d w = dx.tail<3>();
+    const double angle = w.norm();
+    if (angle > 0.0) T.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+    T.translation() = dx.head<3>();
+    return T;
+}
+
+// The residuals of `source` moved by T against the map, linearised for an update about the
+// sensor's position (a rotation about the sensor, then a translation: the two barely couple).
+Equations Linearise(const detail::LocalMap& map, const std::vector<Eigen::Vector3d>& source,
+                    const Eigen::Isometry3d& T, double threshold, double kernel) {
+    const Eigen::Vector3d centre = T.translation();
+    using Range = tbb::blocked_range<size_t>;
+    return tbb::parallel_deterministic_reduce(
+        Range(0, source.size(), kPointGrain), Equations{},
+        [&](const Range& range, Equations e) {
+            detail::MapMatch m;
+            for (size_t i = range.begin(); i != range.end(); ++i) {
+                const Eigen::Vector3d p = T * source[i];
+                if (!map.Nearest(p, threshold, &m)) continue;
+                const Eigen::Vector3d arm = p - centre;
+                if (m.shape == detail::Shape::kPlane) {  // the distance to the plane
+                    Eigen::Matrix<double, 1, 6> J;
+                    J << m.axis.transpose(), arm.cross(m.axis).transpose();
+                    Eigen::Matrix<double, 1, 1> r;
+                    r(0) = m.axis.dot(p - m.point);
+                    e.Add(J, r, Weight(r(0) * r(0), kernel));
+                    e.arms += arm.squaredNorm();
+                } else if (m.shape == detail::Shape::kLine && std::abs(m.axis.z()) >= kMinLineZ) {
+                    // The distance across a pole, a trunk, an upright edge (its direction
+                    // projected out).
+                    const Eigen::Matrix3d across =
+                        Eigen::Matrix3d::Identity() - m.axis * m.axis.transpose();
+                    Eigen::Matrix<double, 3, 6> J;
+                    J << across, -across * Skew(arm);
+                    const Eigen::Vector3d r = across * (p - m.point);
+                    e.Add(J, r, Weight(r.squaredNorm(), kernel));
+                    e.arms += arm.squaredNorm();
+                }
+            }
+            return e;
+        },
+        [](Equations a, const Equations& b) {
+            a.Join(b);
+            return a;
+        });
+}
+
+}  // namespace
+
+void OdometryConfig::Validate() const {
+    const auto require = [](bool ok, const char* what) {
+        if (!ok) throw InvalidArgumentError(std::string("odometry: ") + what);
+    };
+    require(voxel_m > 0.0, "voxel_m must be > 0");
+    require(max_points_per_voxel >= 1, "max_points_per_voxel must be >= 1");
+    require(min_range_m >= 0.0 && max_range_m > min_range_m, "need 0 <= min_range_m < max_range_m");
+    require(initial_threshold_m > 0.0, "initial_threshold_m must be > 0");
+    require(min_motion_m >= 0.0, "min_motion_m must be >= 0");
+    require(max_iterations >= 1, "max_iterations must be >= 1");
+    require(convergence > 0.0, "convergence must be > 0");
+    require(min_correspondences >= 6, "min_correspondences must be >= 6");
+    require(min_overlap >= 0.0 && min_overlap <= 1.0, "min_overlap must be in [0, 1]");
+    require(max_planarity_ratio >= 0.0 && max_planarity_ratio <= 1.0,
+            "max_planarity_ratio must be in [0, 1]");
+}
+
+struct Odometry::State {
+    OdometryConfig config;
+    Eigen::Isometry3d T_world_first;
+    detail::LocalMap map;
+    std::vector<Eigen::Isometry3d> poses;
+    // The motion model's errors (metres, rotation as arc length at max range): their RMS over
+    // the scans that moved sets the correspondence distance.
+    double error_squares = 0.0;
+    size_t errors = 0;
+
+    State(const OdometryConfig& c, const Eigen::Isometry3d& first)
+        : config(c),
+          T_world_first(first),
+          map(c.voxel_m, c.max_points_per_voxel, c.max_planarity_ratio) {}
+
+    [[nodiscard]] Eigen::Isometry3d Prediction() const {
+        if (poses.empty()) return T_world_first;
+        if (poses.size() == 1) return poses.back();
+        const Eigen::Isometry3d& a = poses[poses.size() - 2];
+        const Eigen::Isometry3d& b = poses.back();
+        return b * (a.inverse() * b);
+    }
+    [[nodiscard]] double Sigma() const {
+        return errors == 0 ? config.initial_threshold_m
+                           : std::sqrt(error_squares / static_cast<double>(errors));
+    }
+    void Learn(const Eigen::Isometry3d& predicted, const Eigen::Isometry3d& found) {
+        const Eigen::Isometry3d d = predicted.inverse() * found;
+        const double angle = Eigen::AngleAxisd(d.linear()).angle();
+        const double error =
+            d.translation().norm() + 2.0 * config.max_range_m * std::sin(angle / 2.0);
+        if (error <= config.min_motion_m) return;
+        error_squares += error * error;
+        ++errors;
+    }
+    void Keep(const std::vector<Eigen::Vector3d>& frame, const Eigen::Isometry3d& T) {
+        std::vector<Eigen::Vector3d> world(frame.size());
+        for (size_t i = 0; i < frame.size(); ++i) world[i] = T * frame[i];
+        map.Add(world);
+        map.RemoveFarFrom(T.translation(), config.max_range_m);
+        poses.push_back(T);
+    }
+};
+
+Odometry::Odometry(const OdometryConfig& config, const Eigen::Isometry3d& T_world_first) {
+    config.Validate();
+    state_ = std::make_unique<State>(config, T_world_first);
+}
+Odometry::~Odometry() = default;
+Odometry::Odometry(Odometry&&) noexcept = default;
+Odometry& Odometry::operator=(Odometry&&) noexcept = default;
+
+const std::vector<Eigen::Isometry3d>& Odometry::poses() const { return state_->poses; }
+size_t Odometry::map_cells() const { return state_->map.cells(); }
+size_t Odometry::map_points() const { return state_->map.points(); }
+
+void Odometry::AddToMap(const std::vector<Eigen::Vector3d>& points_world) {
+    state_->map.Add(Downsample(points_world, kMapThinning * state_->config.voxel_m));
+}
+
+OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points) {
+    return Register(points, state_->Prediction());
+}
+
+OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points,
+                                const Eigen::Isometry3d& guess) {
+    State& s = *state_;
+    const OdometryConfig& c = s.config;
+    const std::vector<Eigen::Vector3d> frame =
+        Downsample(points, kMapThinning * c.voxel_m, c.min_range_m, c.max_range_m);
+    const std::vector<Eigen::Vector3d> source = Downsample(frame, kSourceThinning * c.voxel_m);
+    OdometryStep step;
+    step.T_world_sensor = guess;
+    step.points = source.size();
+    if (s.map.empty()) {  // the first scan: the map starts in its frame
+        if (frame.empty()) {
+            char text[120];
+            std::snprintf(text, sizeof(text), "no points between %.1f and %.1f m to start from",
+                          c.min_range_m, c.max_range_m);
+            step.failure = text;
+            return step;
+        }
+        s.Keep(frame, step.T_world_sensor);
+        step.registered = true;
+        return step;
+    }
+    // Matches within three deviations of the motion model, and never beyond one cell: a shape
+    // holds only around where it was fitted (farther, the point's own surface may be another, a
+    // facade that ended), so nothing is learnt from a farther match.
+    const double sigma = s.Sigma();
+    step.threshold_m = std::min(3.0 * sigma, c.voxel_m);
+    Eigen::Isometry3d T = step.T_world_sensor;
+    Equations e;
+    for (step.iterations = 1; step.iterations <= c.max_iterations; ++step.iterations) {
+        e = Linearise(s.map, source, T, step.threshold_m, sigma / 3.0);
+        if (e.matched < 6) break;
+        Vector6d dx;
+        step.min_eigenvalue = SolveConstrained(
+            e, std::sqrt(e.arms / static_cast<double>(e.matched)), kMinEigenvalue, &dx);
+        if (!dx.allFinite()) break;
+        const Eigen::Translation3d to_sensor(T.translation());
+        T = to_sensor * Exp(dx) * to_sensor.inverse() * T;
+        // Products of rotations drift from orthonormal in the last bits; a scan's poses are
+        // products of thousands of them by the end of a drive.
+        T.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+        if (dx.norm() < c.convergence) break;
+    }
+    step.iterations = std::min(step.iterations, c.max_iterations);
+    e = Linearise(s.map, source, T, step.threshold_m, sigma / 3.0);  // where it ended
+    step.correspondences = e.matched;
+    step.rmse_m = e.matched > 0 ? std::sqrt(e.squared / static_cast<double>(e.matched)) : 0.0;
+    const double overlap =
+        source.empty() ? 0.0 : static_cast<double>(e.matched) / static_cast<double>(source.size());
+    if (!T.matrix().allFinite()) {
+        step.failure = "the registration diverged (a pose that is not finite)";
+        return step;
+    }
+    if (e.matched < static_cast<size_t>(c.min_correspondences) || overlap < c.min_overlap) {
+        char text[200];
+        std::snprintf(text, sizeof(text),
+                      "too little overlap with the map: %zu of %zu points matched within %.2f m "
+                      "(needs %d and %.0f %%)",
+                      e.matched, source.size(), step.threshold_m, c.min_correspondences,
+                      100.0 * c.min_overlap);
+        step.failure = text;
+        return step;
+    }
+    s.Learn(step.T_world_sensor, T);
+    s.Keep(frame, T);
+    step.T_world_sensor = T;
+    step.registered = true;
+    return step;
+}
+
+}  // namespace strata::registration

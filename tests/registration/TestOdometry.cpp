@@ -1,0 +1,154 @@
+// LiDAR odometry against known answers: a drive through the simulator's district with the poses
+// withheld (drift as KITTI measures it), a scan from elsewhere (refused), KITTI 00's first frames
+// against two stereo odometries, and the trajectory metrics on trajectories whose errors are
+// known (docs/odometry.md).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "RealData.hpp"
+#include "Sanitizer.hpp"
+#include "SimulatedDrive.hpp"
+#include "strata/core/Error.hpp"
+#include "strata/io/KittiSequence.hpp"
+#include "strata/io/PoseFiles.hpp"
+#include "strata/registration/Odometry.hpp"
+#include "strata/registration/Surface.hpp"
+#include "strata/registration/TrajectoryError.hpp"
+
+namespace strata::registration {
+namespace {
+
+namespace fs = std::filesystem;
+
+Eigen::Isometry3d Pose(double x, double y, double yaw_deg) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).matrix();
+    T.translation() = Eigen::Vector3d(x, y, 0.0);
+    return T;
+}
+
+TEST(TrajectoryError, DriftOfAKnownScaleErrorAndATurn) {
+    // 201 poses 1 m apart along x; the estimate runs 1 % long: every sub-sequence of length L is
+    // 0.01 L too long, so t_rel is 1 % and r_rel 0.
+    std::vector<Eigen::Isometry3d> truth, longer, turned;
+    for (int i = 0; i <= 200; ++i) {
+        truth.push_back(Pose(i, 0, 0));
+        longer.push_back(Pose(1.01 * i, 0, 0));
+        // Yaw creeping 0.01 deg a pose: each 100 m sub-sequence ends 1 deg off.
+        turned.push_back(Pose(i, 0, 0.01 * i));
+    }
+    const Drift d = RelativeDrift(longer, truth, {50.0, 100.0});
+    EXPECT_NEAR(d.translation_percent, 1.0, 1e-9);
+    EXPECT_NEAR(d.rotation_deg_per_100m, 0.0, 1e-9);
+    EXPECT_GT(d.segments, 20u);
+    const Drift r = RelativeDrift(turned, truth, {100.0});
+    EXPECT_NEAR(r.rotation_deg_per_100m, 1.0, 1e-9);
+    // A rigid motion of the whole estimate is no error for either metric.
+    std::vector<Eigen::Isometry3d> moved;
+    for (const Eigen::Isometry3d& T : truth) moved.push_back(Pose(5, -3, 30) * T);
+    EXPECT_NEAR(RelativeDrift(moved, truth, {100.0}).translation_percent, 0.0, 1e-9);
+    EXPECT_NEAR(AbsoluteTrajectoryRmse(moved, truth), 0.0, 1e-9);
+    EXPECT_NEAR(AbsoluteTrajectoryRmse(longer, truth), 0.0, 1.0) << "1 % of 200 m, fitted";
+    EXPECT_THROW((void)RelativeDrift(moved, {truth[0]}, {100.0}), InvalidArgumentError);
+}
+
+// Measured on 2026-12-05 over the first street of the drive (164 sweeps, 163 m; the route then
+// turns its heading 90 degrees within four sweeps, which no vehicle does and the odometry does
+// not follow: docs/odometry.md, "Not done"): t_rel 0.228 %, r_rel 0.050 deg/100 m, ATE 0.111 m.
+// Held at about 2x.
+constexpr double kMaxStraightTranslationPercent = 0.5;
+constexpr double kMaxStraightRotationDegPer100m = 0.1;
+constexpr double kMaxStraightAteM = 0.25;
+constexpr size_t kDriveSweeps = 170;  // the first corner comes at sweep 164
+
+TEST(Odometry, DriftAlongASimulatedStreet) {
+    const test::SimulatedDrive& drive =
+        test::DistrictDrive(strata::testing::UnderSanitizer() ? 40 : kDriveSweeps);
+    const size_t straight = drive.Straight();  // the sweeps up to the first corner
+    Odometry odometry;
+    std::vector<Eigen::Isometry3d> estimate;
+    for (size_t k = 0; k < straight; ++k) {
+        const OdometryStep step = odometry.Register(drive.sweeps[k]);
+        ASSERT_TRUE(step.registered) << "scan " << k << ": " << step.failure;
+        estimate.push_back(drive.truth.front() * step.T_world_sensor);
+    }
+    const std::vector<Eigen::Isometry3d> truth(drive.truth.begin(),
+                                               drive.truth.begin() + static_cast<long>(straight));
+    const Drift d = RelativeDrift(estimate, truth, {25.0, 50.0, 100.0}, 5);
+    const double ate = AbsoluteTrajectoryRmse(estimate, truth);
+    std::printf(
+        "%zu sweeps, %.0f m: t_rel %.3f %%, r_rel %.4f deg/100 m (%zu segments), "
+        "ATE %.3f m\n",
+        straight, (truth.back().translation() - truth.front().translation()).norm(),
+        d.translation_percent, d.rotation_deg_per_100m, d.segments, ate);
+    ::testing::Test::RecordProperty("t_rel_percent", std::to_string(d.translation_percent));
+    ::testing::Test::RecordProperty("r_rel_deg_per_100m", std::to_string(d.rotation_deg_per_100m));
+    ::testing::Test::RecordProperty("ate_m", std::to_string(ate));
+    if (strata::testing::UnderSanitizer()) return;  // 40 m: too short for the 100 m figures
+    ASSERT_GE(straight, 150u);
+    EXPECT_LT(d.translation_percent, kMaxStraightTranslationPercent);
+    EXPECT_LT(d.rotation_deg_per_100m, kMaxStraightRotationDegPer100m);
+    EXPECT_LT(ate, kMaxStraightAteM);
+}
+
+TEST(Odometry, AScanFromElsewhereIsRefusedAndChangesNothing) {
+    const test::SimulatedDrive& drive =
+        test::DistrictDrive(strata::testing::UnderSanitizer() ? 40 : kDriveSweeps);
+    Odometry odometry;
+    ASSERT_TRUE(odometry.Register(drive.sweeps[0]).registered);
+    ASSERT_TRUE(odometry.Register(drive.sweeps[1]).registered);
+    // The next sweep as if seen 300 m away: nothing of it lies near the map.
+    std::vector<Eigen::Vector3d> elsewhere = drive.sweeps[2];
+    for (Eigen::Vector3d& p : elsewhere) p += Eigen::Vector3d(300.0, 0.0, 0.0);
+    const size_t cells = odometry.map_cells();
+    const OdometryStep refused = odometry.Register(elsewhere);
+    EXPECT_FALSE(refused.registered);
+    EXPECT_NE(refused.failure.find("too little overlap"), std::string::npos) << refused.failure;
+    EXPECT_EQ(odometry.poses().size(), 2u);
+    EXPECT_EQ(odometry.map_cells(), cells);
+    // The drive goes on from where it was.
+    EXPECT_TRUE(odometry.Register(drive.sweeps[2]).registered);
+}
+
+// KITTI 00's six frames (0.7 m apart) against the two stereo odometries of the data README
+// (its published poses are wrong there by ~0.17 m a frame): the distance covered by frame 5 and
+// the yaw turned. Measured on 2026-12-05: 3.607 m and 1.216 deg, where ORB-SLAM2 has 3.537 m and
+// 1.162 deg and S-PTAM 3.650 m and 1.281 deg (the scans' own ICP optimum: 3.58 m, 1.17 deg).
+constexpr double kKittiDistanceSlackM = 0.05;  // beyond the two stereo results
+constexpr double kKittiYawSlackDeg = 0.1;
+
+TEST(OdometryRealData, Kitti00SixFramesAgreeWithTheStereoOdometries) {
+    const fs::path dir = fs::path(STRATA_DATA_DIR) / "kitti00";
+    STRATA_SKIP_WITHOUT_DATA(dir / "poses_orbslam2.txt");
+    const io::KittiSequence seq = io::OpenKittiSequence(dir);
+    Odometry odometry;
+    for (size_t k = 0; k < 6; ++k) {
+        const OdometryStep step = odometry.Register(io::ReadKittiBin(seq.scan_files[k]).points);
+        ASSERT_TRUE(step.registered) << "frame " << k << ": " << step.failure;
+    }
+    const Eigen::Isometry3d ours = odometry.poses()[5];
+    const double yaw = std::atan2(ours.linear()(1, 0), ours.linear()(0, 0)) * 180.0 / M_PI;
+    const Eigen::Isometry3d Tr = io::ReadKittiCalibTr(dir / "calib.txt");
+    double lo = 1e9, hi = 0.0, yaw_lo = 1e9, yaw_hi = -1e9;
+    for (const char* name : {"poses_orbslam2.txt", "poses_sptam.txt"}) {
+        const std::vector<Eigen::Isometry3d> cams = io::ReadKittiPoses(dir / name);
+        // Camera poses to the LiDAR's, relative to frame 0 (data README).
+        const Eigen::Isometry3d T =
+            (Tr.inverse() * cams[0] * Tr).inverse() * Tr.inverse() * cams[5] * Tr;
+        lo = std::min(lo, T.translation().norm());
+        hi = std::max(hi, T.translation().norm());
+        const double y = std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI;
+        yaw_lo = std::min(yaw_lo, y);
+        yaw_hi = std::max(yaw_hi, y);
+    }
+    std::printf("frame 5: %.3f m (stereo %.3f-%.3f), yaw %.3f deg (stereo %.3f-%.3f)\n",
+                ours.translation().norm(), lo, hi, yaw, yaw_lo, yaw_hi);
+    EXPECT_GT(ours.translation().norm(), lo - kKittiDistanceSlackM);
+    EXPECT_LT(ours.translation().norm(), hi + kKittiDistanceSlackM);
+    EXPECT_GT(std::abs(yaw), std::abs(yaw_lo) - kKittiYawSlackDeg);
+    EXPECT_LT(std::abs(yaw), std::abs(yaw_hi) + kKittiYawSlackDeg);
+}
+
+}  // namespace
+}  // namespace strata::registration
