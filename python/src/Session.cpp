@@ -7,6 +7,7 @@
 #include "StoredMap.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/NewSession.hpp"
+#include "strata/registration/Odometry.hpp"
 
 namespace strata::python {
 
@@ -16,7 +17,7 @@ namespace {
 /// an exception in a `with` block) leaves the map as it was.
 class Session {
 public:
-    Session(const StoredMap& map, const std::string& name, double memory_budget_mb)
+    Session(const StoredMap& map, const std::string& name, double memory_budget_mb, bool odometry)
         : store_(map.store) {
         if (!store_) throw InvalidArgumentError("the map is closed");
         if (!store_->writable()) {
@@ -30,20 +31,51 @@ public:
         options.source = "python";
         options.memory_budget_bytes = static_cast<size_t>(memory_budget_mb * 1e6);
         session_ = std::make_unique<pipeline::NewSession>(*store_, map.config, options);
+        if (odometry) odometry_.emplace();
     }
 
-    py::dict Integrate(const py::array& points, const py::array& pose, const py::object& labels,
+    py::dict Integrate(const py::array& points, const py::object& pose, const py::object& labels,
                        const py::object& classes, const py::object& ray_origins,
                        const py::object& ray_starts) {
         pipeline::NewSession& session = Writer();
-        const core::Scan scan =
-            ScanFromArrays(points, pose, labels, classes, ray_origins, ray_starts);
+        if (odometry_.has_value() != pose.is_none()) {
+            throw InvalidArgumentError(odometry_ ? "this session estimates its poses "
+                                                   "(odometry=True): give points without a pose"
+                                                 : "integrate() needs a pose (or a session "
+                                                   "made with odometry=True)");
+        }
+        // With odometry the pose comes after the points are read: identity until then.
+        const py::array given = odometry_ ? py::array(MatrixToArray(Eigen::Matrix4d::Identity()))
+                                          : py::array::ensure(pose);
+        if (!given) throw InvalidArgumentError("pose must be a (4, 4) or (3, 4) array");
+        core::Scan scan = ScanFromArrays(points, given, labels, classes, ray_origins, ray_starts);
         integration::ScanUpdate update;
         {
             py::gil_scoped_release release;
+            if (odometry_) {
+                const registration::OdometryStep step = odometry_->Register(scan.points);
+                if (!step.registered) {
+                    throw RefusedError("scan " + std::to_string(session.scans()) +
+                                       " (numpy): " + step.failure);
+                }
+                scan.T_world_sensor = step.T_world_sensor;
+            }
             update = session.Integrate(scan);
         }
         return UpdateCounts(update.points, update.dropped, update.clipped);
+    }
+
+    // The poses the odometry estimated, (N, 4, 4); None for a session given its poses.
+    [[nodiscard]] py::object Poses() const {
+        if (!odometry_) return py::none();
+        std::vector<double> flat;
+        for (const Eigen::Isometry3d& T : odometry_->poses()) {
+            for (int r = 0; r < 4; ++r) {
+                for (int c = 0; c < 4; ++c) flat.push_back(T.matrix()(r, c));
+            }
+        }
+        const auto n = static_cast<py::ssize_t>(odometry_->poses().size());
+        return ToArray(std::move(flat), {n, 4, 4});
     }
 
     py::dict Commit() {
@@ -75,6 +107,7 @@ private:
 
     std::shared_ptr<store::MapStore> store_;  // the writer refers to it: kept alive with it
     std::unique_ptr<pipeline::NewSession> session_;
+    std::optional<registration::Odometry> odometry_;  // odometry=True: poses estimated
     std::optional<py::dict> committed_;
 };
 
@@ -82,14 +115,15 @@ private:
 
 void RegisterSession(py::module_& m) {
     py::class_<Session>(m, "_Session")
-        .def(py::init<const StoredMap&, const std::string&, double>(), py::arg("map"),
-             py::arg("name"), py::arg("memory_budget_mb") = 0.0)
+        .def(py::init<const StoredMap&, const std::string&, double, bool>(), py::arg("map"),
+             py::arg("name"), py::arg("memory_budget_mb") = 0.0, py::arg("odometry") = false)
         .def("integrate", &Session::Integrate, py::arg("points"), py::arg("pose"),
              py::arg("labels") = py::none(), py::arg("classes") = py::none(),
              py::arg("ray_origins") = py::none(), py::arg("ray_starts") = py::none())
         .def("commit", &Session::Commit)
         .def("abort", &Session::Abort)
-        .def_property_readonly("record", &Session::Record);
+        .def_property_readonly("record", &Session::Record)
+        .def_property_readonly("poses", &Session::Poses);
 }
 
 }  // namespace strata::python

@@ -113,9 +113,11 @@ class Session:
     block ends and, when the block raises, removes what it wrote: the map is as before.
     """
 
-    def __init__(self, map: "Map", name: str = "", memory_budget_mb: float = 0.0):
+    def __init__(self, map: "Map", name: str = "", memory_budget_mb: float = 0.0,
+                 odometry: bool = False):
         self._map = map
-        self._impl = _strata._Session(map._impl, name, memory_budget_mb)
+        self._odometry = odometry
+        self._impl = _strata._Session(map._impl, name, memory_budget_mb, odometry)
 
     def integrate(self, points, pose=None, labels=None, classes=None, ray_origins=None,
                   ray_starts=None) -> dict:
@@ -123,16 +125,24 @@ class Session:
         alone) with the map's integration rule, through the same session writer as
         `strata integrate`; nothing reaches the map on disk before commit(). Returns
         {"points", "dropped", "clipped"}. An error about the scan names it
-        ("scan 3 (numpy): ...")."""
+        ("scan 3 (numpy): ..."). In a session made with odometry=True give no pose: the
+        odometry registers the points to the scans before (a Scan's pose is ignored), and a
+        scan it cannot register raises RefusedError."""
         if isinstance(points, Scan):
             if pose is not None:
                 raise TypeError("integrate(scan) takes the pose from the Scan")
             s = points
-            return self._impl.integrate(s.points, s.pose, s.labels, s.classes, s.ray_origins,
-                                        s.ray_starts)
-        if pose is None:
-            raise TypeError("integrate() needs a pose with points (or a strata.Scan alone)")
+            # A Scan from strata.simulate has both; the labels (with instances) are the fuller.
+            classes = s.classes if s.labels is None else None
+            return self._impl.integrate(s.points, None if self._odometry else s.pose, s.labels,
+                                        classes, s.ray_origins, s.ray_starts)
         return self._impl.integrate(points, pose, labels, classes, ray_origins, ray_starts)
+
+    @property
+    def poses(self) -> Optional[np.ndarray]:
+        """With odometry=True, the poses the odometry found so far, (N, 4, 4) in the first scan's
+        frame (docs/odometry.md); None for a session given its poses."""
+        return self._impl.poses
 
     def commit(self) -> dict:
         """Writes the session in one transaction; returns its record (as Map.sessions())."""
@@ -209,10 +219,12 @@ class Map:
     def voxel_size(self) -> float:
         return self._impl.voxel_size
 
-    def session(self, name: str = "", memory_budget_mb: float = 0.0) -> Session:
+    def session(self, name: str = "", memory_budget_mb: float = 0.0,
+                odometry: bool = False) -> Session:
         """A new session named `name` (default session_<id>); use it in a `with` block.
-        memory_budget_mb > 0 keeps at most that many MB of tiles in memory."""
-        return Session(self, name, memory_budget_mb)
+        memory_budget_mb > 0 keeps at most that many MB of tiles in memory. odometry=True: the
+        scans come without poses and LiDAR odometry estimates them (docs/odometry.md)."""
+        return Session(self, name, memory_budget_mb, odometry)
 
     def sessions(self) -> list:
         """The map's sessions, oldest first, as dicts (id, name, scans, points, ...)."""

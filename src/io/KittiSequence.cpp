@@ -54,7 +54,7 @@ std::vector<ScanFile> ListScans(const fs::path& velodyne) {
 
 }  // namespace
 
-KittiSequence OpenKittiSequence(const fs::path& dir) {
+KittiSequence OpenKittiSequence(const fs::path& dir, bool require_poses) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
         throw NotFoundError(dir.string() + ": not a directory (expected a KITTI sequence)");
@@ -68,7 +68,10 @@ KittiSequence OpenKittiSequence(const fs::path& dir) {
     const size_t frames_needed = scans.back().frame + 1;
 
     const fs::path poses_txt = dir / "poses.txt";
-    const std::vector<Eigen::Isometry3d> poses = ReadKittiPoses(poses_txt);
+    const std::vector<Eigen::Isometry3d> poses =
+        require_poses || fs::exists(poses_txt, ec)
+            ? ReadKittiPoses(poses_txt)
+            : std::vector<Eigen::Isometry3d>(frames_needed, Eigen::Isometry3d::Identity());
     if (poses.size() < frames_needed) {
         throw FormatError(poses_txt.string() + ": " + std::to_string(poses.size()) +
                           " poses, but the sequence has " + std::to_string(scans.size()) +

@@ -1,7 +1,6 @@
 #include "strata/io/PoseFiles.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -9,6 +8,7 @@
 
 #include "TextParsing.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/io/AtomicFile.hpp"
 
 namespace strata::io {
 namespace {
@@ -157,22 +157,21 @@ std::vector<double> ReadTimes(const std::filesystem::path& path) {
 
 namespace {
 
-// Writes with full double precision and reports any stream failure (e.g. a full disk).
+// Writes with full double precision, whole or not at all (WriteFileAtomically reports any
+// stream failure, a full disk say, and leaves an existing file as it was).
 template <typename Body>
 void WriteText(const std::filesystem::path& path, Body body) {
-    std::ofstream out(path);
-    if (!out) throw IoError(path.string() + ": cannot open file for writing");
-    out.precision(std::numeric_limits<double>::max_digits10);
-    body(out);
-    out.close();
-    if (!out) throw IoError(path.string() + ": write error");
+    WriteFileAtomically(path, [&](std::ostream& out) {
+        out.precision(std::numeric_limits<double>::max_digits10);
+        body(out);
+    });
 }
 
 }  // namespace
 
 void WriteKittiPoses(const std::filesystem::path& path,
                      const std::vector<Eigen::Isometry3d>& poses) {
-    WriteText(path, [&](std::ofstream& out) {
+    WriteText(path, [&](std::ostream& out) {
         for (const Eigen::Isometry3d& T : poses) {
             for (int k = 0; k < 12; ++k) out << (k ? " " : "") << T.matrix()(k / 4, k % 4);
             out << '\n';
@@ -181,7 +180,7 @@ void WriteKittiPoses(const std::filesystem::path& path,
 }
 
 void WriteTumPoses(const std::filesystem::path& path, const std::vector<StampedPose>& poses) {
-    WriteText(path, [&](std::ofstream& out) {
+    WriteText(path, [&](std::ostream& out) {
         out << "# t x y z qx qy qz qw\n";
         for (const StampedPose& p : poses) {
             const Eigen::Quaterniond q(p.T.linear());

@@ -17,12 +17,18 @@ namespace {
 // Reads, aligns and integrates into an open map; commits only when every scan went in.
 IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOptions& options) {
     store::MapStore& map = opened.map;
-    const ScanSource source = ScanSource::Open(scans, map.settings().origin);
+    ScanSource source = ScanSource::Open(scans, map.settings().origin);
     IntegrateResult result;
     result.created = opened.created;
     store::SessionOptions session;
     session.name = options.name;
     session.source = source.Describe();
+    if (options.odometry) {
+        // Poses first, written before anything reaches the map: a refusal commits nothing.
+        result.odometry = EstimateTrajectory(source, *options.odometry);
+        source = source.Posed(result.odometry->scans, result.odometry->poses);
+        if (!options.poses_out.empty()) WriteTrajectory(options.poses_out, *result.odometry);
+    }
     session.memory_budget_bytes = static_cast<size_t>(options.memory_budget_mb * 1e6);
     if (options.align) {
         // Aligned before anything is written: a refusal commits nothing.
@@ -145,12 +151,19 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
 void IntegrateOptions::Validate() const {
     map.rule.Validate();
     if (!(memory_budget_mb >= 0.0)) throw InvalidArgumentError("--memory-budget must be >= 0");
+    if (odometry) odometry->config.Validate();
+    if (!poses_out.empty()) {
+        if (!odometry) throw InvalidArgumentError("--poses-out needs --odometry");
+        RequireTrajectoryFile(poses_out);
+    }
 }
 
-IntegrateResult IntegrateSession(const std::filesystem::path& dir, const ScanSpec& scans,
+IntegrateResult IntegrateSession(const std::filesystem::path& dir, const ScanSpec& given,
                                  const IntegrateOptions& options) {
-    scans.Validate();
+    given.Validate();
     options.Validate();
+    ScanSpec scans = given;
+    if (options.odometry) scans.require_poses = false;  // the odometry estimates them
     const bool exists = store::MapStore::IsMap(dir);
     if (options.align && !exists) {
         throw InvalidArgumentError("--align needs a map to align to; " + dir.string() +
@@ -162,6 +175,9 @@ IntegrateResult IntegrateSession(const std::filesystem::path& dir, const ScanSpe
         request.georeference_from = scans.files.front();
     }
     if (options.ranks && options.ranks->size() > 1) {
+        if (options.odometry) {
+            throw InvalidArgumentError("--odometry runs in one process, not under mpirun");
+        }
         return RunOnRanks(dir, request, scans, options);
     }
     std::optional<OpenedMap> opened;

@@ -17,7 +17,7 @@ void ScanSpec::Validate() const {
 
 ScanSource ScanSource::Open(const ScanSpec& spec, const Eigen::Vector3d& origin) {
     spec.Validate();
-    if (!spec.kitti.empty()) return Kitti(spec.kitti, spec.frames);
+    if (!spec.kitti.empty()) return Kitti(spec.kitti, spec.frames, spec.require_poses);
     if (!spec.bag.empty()) {
         recordings::RecordedScanOptions options = spec.recording;
         options.frames = spec.frames;
@@ -29,9 +29,9 @@ ScanSource ScanSource::Open(const ScanSpec& spec, const Eigen::Vector3d& origin)
     return Files(spec.files, spec.poses, options);
 }
 
-ScanSource ScanSource::Kitti(const fs::path& dir, const std::string& frames) {
+ScanSource ScanSource::Kitti(const fs::path& dir, const std::string& frames, bool require_poses) {
     ScanSource s;
-    s.kitti_ = io::OpenKittiSequence(dir);
+    s.kitti_ = io::OpenKittiSequence(dir, require_poses);
     const auto [begin, end] = core::ParseFrameRange(frames, s.kitti_->size());
     for (size_t i = begin; i < end; ++i) s.indices_.push_back(i);
     return s;
@@ -62,11 +62,31 @@ ScanSource ScanSource::Files(std::vector<fs::path> files, const fs::path& poses,
     return s;
 }
 
+ScanSource ScanSource::Posed(const std::vector<size_t>& scans,
+                             std::vector<Eigen::Isometry3d> poses) const {
+    if (recording_) throw InvalidArgumentError("a recording's sweeps are posed by its tf tree");
+    if (scans.size() != poses.size()) {
+        throw InvalidArgumentError(std::to_string(poses.size()) + " poses for " +
+                                   std::to_string(scans.size()) + " scans");
+    }
+    ScanSource s = *this;
+    s.indices_.clear();
+    for (const size_t k : scans) s.indices_.push_back(indices_.at(k));
+    s.posed_ = std::move(poses);
+    return s;
+}
+
 core::Scan ScanSource::Read(size_t i) const {
-    if (kitti_) return io::ReadKittiScan(*kitti_, indices_.at(i));
     if (recording_) return recording_->Read(i);
-    core::Scan scan = io::ReadPointCloud(files_.at(i), options_);
-    if (!poses_.empty()) scan.T_world_sensor = poses_[i];
+    const size_t k = indices_.at(i);
+    core::Scan scan;
+    if (kitti_) {
+        scan = io::ReadKittiScan(*kitti_, k);
+    } else {
+        scan = io::ReadPointCloud(files_.at(k), options_);
+        if (!poses_.empty()) scan.T_world_sensor = poses_[k];
+    }
+    if (!posed_.empty()) scan.T_world_sensor = posed_.at(i);
     return scan;
 }
 

@@ -22,6 +22,7 @@ void RegisterRegister(CLI::App& app);
 void RegisterFloors(CLI::App& app);
 void RegisterView(CLI::App& app);
 void RegisterBag(CLI::App& app);
+void RegisterOdometry(CLI::App& app);
 
 /// The processes this command runs on: this one alone, or the ranks of `mpirun` (docs/scale.md).
 /// Commands that share their work (integrate) pass it to the pipeline; the others run on

@@ -11,6 +11,7 @@
 #include "Commands.hpp"
 #include "Progress.hpp"
 #include "ScanOptions.hpp"
+#include "strata/core/Error.hpp"
 
 namespace strata::tools {
 
@@ -28,6 +29,9 @@ struct IntegrateArgs {
     integration::IntegrationConfig config;  // the flags' values; a map's rule once it exists
     bool align = false;
     AlignArgs align_args;
+    bool odometry = false;
+    std::string poses_out;
+    std::string on_failure = "stop";
 };
 
 // The map the flags ask for: only the flags the user gave are checked against an existing map.
@@ -61,6 +65,9 @@ void PrintStart(const pipeline::IntegrationStart& s, const IntegrateArgs& args) 
         std::cerr << "strata integrate: sweeps of " << r->points_topic() << " posed in "
                   << r->fixed_frame() << ", " << r->deskew_note() << "\n";
     }
+    if (args.odometry) {
+        std::cerr << "strata integrate: poses by LiDAR odometry, in the first scan's frame\n";
+    }
 }
 
 void Run(const IntegrateArgs& args, const CLI::App& cmd) {
@@ -80,6 +87,14 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
     options.name = args.name;
     options.memory_budget_mb = args.memory_budget_mb;
     if (args.align) options.align = AlignRequestOf(args.align_args);
+    if (args.odometry) {
+        options.odometry.emplace();
+        options.odometry->skip_failures = args.on_failure == "skip";
+        options.odometry->progress = ProgressBars();
+    } else if (cmd.count("--odometry-on-failure")) {
+        throw InvalidArgumentError("--odometry-on-failure needs --odometry");
+    }
+    options.poses_out = args.poses_out;
     options.progress = ProgressBars();
     options.on_aligned = [](const pipeline::MapAlignment& a) {
         std::cerr << "strata integrate --align: ";
@@ -88,6 +103,14 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
     options.on_start = [&args](const pipeline::IntegrationStart& s) { PrintStart(s, args); };
     options.ranks = &CommandRanks();
     const pipeline::IntegrateResult r = pipeline::IntegrateSession(args.map, args.scans, options);
+    if (r.odometry) {
+        for (const std::string& skipped : r.odometry->skipped) {
+            std::cerr << "strata integrate --odometry: left out " << skipped << "\n";
+        }
+        std::cout << "odometry: " << r.odometry->poses.size() << " scans posed, "
+                  << r.odometry->length_m << " m in " << r.odometry->seconds << " s"
+                  << (args.poses_out.empty() ? "" : "; poses in " + args.poses_out) << "\n";
+    }
     std::cout << "session " << r.session.id << " (" << r.session.name << "): " << r.session.scans
               << " scans, " << r.session.points << " points in " << r.seconds << " s; wrote "
               << r.stats.tiles_written << " tile files (" << r.stats.bytes_written / 1e6
@@ -114,6 +137,7 @@ void RegisterIntegrate(CLI::App& app) {
         "  strata integrate tile.strata --scans autzen.las --points-only --voxel 1.0\n"
         "  strata integrate city.strata --kitti day2/ --align --init 3,-1,0,10\n"
         "  strata integrate street.strata --bag drive.bag --points-topic /points_raw\n"
+        "  strata integrate street.strata --kitti drive/ --odometry --poses-out poses.txt\n"
         "Each run adds one session; the map changes only once every scan is integrated.");
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     AddScanOptions(*cmd, args->scans);
@@ -144,6 +168,16 @@ void RegisterIntegrate(CLI::App& app) {
                   "Align the session to the map first (strata register); refuse and commit "
                   "nothing when it fails; the transform is kept as the session's alignment");
     AddAlignOptions(*cmd, args->align_args, false);
+    cmd->add_flag("--odometry", args->odometry,
+                  "Estimate the scans' poses by LiDAR odometry first (any poses they have are "
+                  "ignored; a --kitti folder needs no poses.txt): docs/odometry.md");
+    cmd->add_option("--poses-out", args->poses_out,
+                    "With --odometry: also write the trajectory, .txt (KITTI) or .tum (TUM)");
+    cmd->add_option("--odometry-on-failure", args->on_failure,
+                    "With --odometry: stop (nothing committed) or skip (leave the scan out) when "
+                    "a scan cannot be registered")
+        ->check(CLI::IsMember({"stop", "skip"}))
+        ->capture_default_str();
     cmd->callback([args, cmd] { Run(*args, *cmd); });
 }
 

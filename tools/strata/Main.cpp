@@ -85,6 +85,7 @@ int RunCommand(int argc, char** argv, const strata::pipeline::Ranks& ranks) {
     strata::tools::RegisterRegister(app);
     strata::tools::RegisterFloors(app);
     strata::tools::RegisterBag(app);
+    strata::tools::RegisterOdometry(app);
     strata::tools::RegisterDemo(app);
     strata::tools::RegisterSimulate(app);
     strata::tools::RegisterView(app);

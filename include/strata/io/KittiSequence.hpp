@@ -28,7 +28,10 @@ struct KittiSequence {
 /// @throws NotFoundError naming the file or folder: no velodyne/ or no scans in it, no
 /// poses.txt, a labels/ folder that lacks a scan's .label file; FormatError: fewer poses (or times)
 /// than needed (the message gives both counts), a non-finite pose, calib.txt without `Tr:`,.
-[[nodiscard]] KittiSequence OpenKittiSequence(const std::filesystem::path& dir);
+/// With `require_poses` false a folder without poses.txt opens with identity poses (scans whose
+/// poses an odometry estimates).
+[[nodiscard]] KittiSequence OpenKittiSequence(const std::filesystem::path& dir,
+                                              bool require_poses = true);
 
 /// @brief Loads scan `index`: points and intensity, labels and instances when the sequence has
 /// labels (SemanticKITTI ids mapped with LabelMapping::SemanticKitti()), pose, time and source.

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "strata/pipeline/Alignment.hpp"
+#include "strata/pipeline/Odometry.hpp"
 #include "strata/pipeline/OpenOrCreate.hpp"
 #include "strata/pipeline/Progress.hpp"
 #include "strata/pipeline/RankedSession.hpp"
@@ -32,6 +33,13 @@ struct IntegrateOptions {
     /// Align the session (its scans in their poses' frame) to the newest map first; the
     /// transform is recorded as the session's alignment.
     std::optional<AlignRequest> align;
+    /// Estimate the scans' poses by odometry first (their own poses, if any, are ignored; a KITTI
+    /// folder needs no poses.txt), then integrate (and align, with `align`) at those; one process
+    /// only (docs/odometry.md).
+    std::optional<OdometryOptions> odometry;
+    /// With `odometry`: the trajectory also written here (.txt KITTI, .tum TUM), before the
+    /// session commits.
+    std::filesystem::path poses_out;
     ProgressCallback progress;  ///< stages "reading scans" (with `align`), "integrating"
     /// Called with the alignment before it is accepted or refused (to report it either way).
     std::function<void(const MapAlignment&)> on_aligned;
@@ -55,6 +63,7 @@ struct IntegrateResult {
     size_t map_tiles = 0;                ///< tiles of the map after the commit
     bool created = false;
     std::optional<MapAlignment> alignment;
+    std::optional<EstimatedTrajectory> odometry;  ///< with IntegrateOptions::odometry
 };
 
 /// @brief Integrates every scan of `scans` into the map in `dir` as one session and commits it.

@@ -28,6 +28,9 @@ struct ScanSpec {
     std::vector<std::filesystem::path> files;  ///< PCD, PLY, LAS, .bin or text (.bz2)
     std::filesystem::path poses;               ///< KITTI 3x4 or TUM, by index; empty: identity
     int bin_fields = 0;  ///< float32 values per point of raw .bin files; 0: from name or size
+    /// False: a KITTI folder without poses.txt opens with identity poses (the odometry
+    /// estimates them).
+    bool require_poses = true;
 
     /// @brief Throws InvalidArgumentError unless exactly one of `kitti`, `files` and `bag` is
     /// given.
@@ -43,7 +46,7 @@ public:
     [[nodiscard]] static ScanSource Open(const ScanSpec& spec, const Eigen::Vector3d& origin);
     /// @brief A KITTI sequence; `frames` as ScanSpec::frames.
     [[nodiscard]] static ScanSource Kitti(const std::filesystem::path& dir,
-                                          const std::string& frames);
+                                          const std::string& frames, bool require_poses = true);
     /// @brief A recording's sweeps (RecordedScans).
     [[nodiscard]] static ScanSource Recording(const std::filesystem::path& bag,
                                               const recordings::RecordedScanOptions& options);
@@ -51,6 +54,12 @@ public:
     [[nodiscard]] static ScanSource Files(std::vector<std::filesystem::path> files,
                                           const std::filesystem::path& poses,
                                           const io::ReadOptions& options);
+
+    /// @brief Scans `scans` of this source (its indices), in that order, at `poses` instead of
+    /// their own: poses an odometry estimated.
+    /// @throw InvalidArgumentError for a recording's sweeps, or sizes that differ.
+    [[nodiscard]] ScanSource Posed(const std::vector<size_t>& scans,
+                                   std::vector<Eigen::Isometry3d> poses) const;
 
     [[nodiscard]] size_t size() const { return recording_ ? recording_->size() : indices_.size(); }
     /// @brief Scan `i` (0 <= i < size()) with its pose; reader errors name the file.
@@ -66,7 +75,8 @@ private:
     std::shared_ptr<const recordings::RecordedScans> recording_;
     std::vector<size_t> indices_;  // into the sequence, or into files_
     std::vector<std::filesystem::path> files_;
-    std::vector<Eigen::Isometry3d> poses_;
+    std::vector<Eigen::Isometry3d> poses_;  // the pose file's, by file
+    std::vector<Eigen::Isometry3d> posed_;  // Posed's, by index i of Read(i)
     io::ReadOptions options_;
 };
 

@@ -1,0 +1,53 @@
+#pragma once
+// `strata odometry`: poses for scans that came without them, written as a trajectory file
+// (docs/odometry.md).
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "strata/pipeline/Progress.hpp"
+#include "strata/pipeline/ScanSource.hpp"
+#include "strata/registration/Odometry.hpp"
+
+namespace strata::pipeline {
+
+/// @brief How the poses of a source's scans are estimated.
+struct OdometryOptions {
+    registration::OdometryConfig config;
+    /// A scan the odometry cannot register stops the run (false) or is left out and listed in
+    /// EstimatedTrajectory::skipped (true).
+    bool skip_failures = false;
+    ProgressCallback progress;  ///< stage "odometry"
+};
+
+/// @brief The poses the odometry found: the sensor of each registered scan in the first scan's
+/// frame.
+struct EstimatedTrajectory {
+    std::vector<Eigen::Isometry3d> poses;
+    std::vector<double> times_s;
+    std::vector<size_t> scans;         ///< the source's index of each pose's scan
+    std::vector<std::string> skipped;  ///< "scan 12 (<file>): why", with skip_failures
+    double seconds = 0.0;
+    double length_m = 0.0;  ///< the path's length
+};
+
+/// @brief Reads each scan of `source` and registers it.
+/// @throw RefusedError naming the scan and why ("scan 12 (<file>): too little overlap ...")
+/// when one cannot be registered and `skip_failures` is false, or when no scan was registered;
+/// the readers' errors; InvalidArgumentError for a bad config.
+[[nodiscard]] EstimatedTrajectory EstimateTrajectory(const ScanSource& source,
+                                                     const OdometryOptions& options);
+
+/// @brief Refuses a trajectory file whose extension is neither `.txt` nor `.tum`.
+/// @throw InvalidArgumentError naming the file.
+void RequireTrajectoryFile(const std::filesystem::path& out);
+
+/// @brief Writes the poses, by extension: `.txt` as KITTI 3x4 rows (the sensor in the map, no
+/// camera calibration), `.tum` as TUM (`t x y z qx qy qz qw`). The file appears whole or not at
+/// all.
+/// @throw InvalidArgumentError for another extension; IoError naming the file.
+void WriteTrajectory(const std::filesystem::path& out, const EstimatedTrajectory& trajectory);
+
+}  // namespace strata::pipeline

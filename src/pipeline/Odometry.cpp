@@ -1,0 +1,64 @@
+#include "strata/pipeline/Odometry.hpp"
+
+#include <chrono>
+
+#include "strata/core/Error.hpp"
+#include "strata/io/PoseFiles.hpp"
+
+namespace strata::pipeline {
+
+EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    registration::Odometry odometry(options.config);
+    EstimatedTrajectory out;
+    ReportProgress(options.progress, "odometry", 0, source.size());
+    for (size_t i = 0; i < source.size(); ++i) {
+        const core::Scan scan = source.Read(i);
+        const registration::OdometryStep step = odometry.Register(scan.points);
+        if (!step.registered) {
+            const std::string why =
+                "scan " + std::to_string(i) + " (" + scan.source + "): " + step.failure;
+            if (!options.skip_failures) {
+                throw RefusedError(why +
+                                   "; nothing written (--odometry-on-failure skip leaves "
+                                   "such scans out)");
+            }
+            out.skipped.push_back(why);
+        } else {
+            if (!out.poses.empty()) {
+                out.length_m +=
+                    (step.T_world_sensor.translation() - out.poses.back().translation()).norm();
+            }
+            out.poses.push_back(step.T_world_sensor);
+            out.times_s.push_back(scan.time_s);
+            out.scans.push_back(i);
+        }
+        ReportProgress(options.progress, "odometry", i + 1, source.size());
+    }
+    if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+void RequireTrajectoryFile(const std::filesystem::path& out) {
+    const std::string extension = out.extension().string();
+    if (extension != ".txt" && extension != ".tum") {
+        throw InvalidArgumentError(out.string() +
+                                   ": a trajectory file ends in .txt (KITTI) or .tum (TUM)");
+    }
+}
+
+void WriteTrajectory(const std::filesystem::path& out, const EstimatedTrajectory& trajectory) {
+    RequireTrajectoryFile(out);
+    if (out.extension() == ".txt") {
+        io::WriteKittiPoses(out, trajectory.poses);
+        return;
+    }
+    std::vector<io::StampedPose> stamped;
+    for (size_t k = 0; k < trajectory.poses.size(); ++k) {
+        stamped.push_back({trajectory.times_s[k], trajectory.poses[k]});
+    }
+    io::WriteTumPoses(out, stamped);
+}
+
+}  // namespace strata::pipeline
