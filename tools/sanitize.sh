@@ -46,7 +46,7 @@ tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection|RayCheck|ClearVehicles
 tsan_tests+='|^OctomapAgreement\.SeveralSynthetic|^RegistrationIcp\.Recovers'
 tsan_tests+='|^Store\.(SessionsEqualInMemory|OneWriterAtATime|ReadersSeeWholeCommits)'
 tsan_tests+='|^WallAssembler\.(AWallCutByASlot|WhatOneReleases)'
-tsan_tests+='|^TileByTile\.RegisterReads|^SessionCloud\.'
+tsan_tests+='|^TileByTile\.TheSurfaceReadAround|^SessionCloud\.'
 # What the TSan selection held (44 on 2026-12-02, the 3 FindWalls tests and 2 WallAssembler
 # tests since 2026-12-04, the matching surface read from a map's tiles by threads and the
 # session cloud since 2026-12-05;

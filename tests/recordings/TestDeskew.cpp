@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "BagFixtures.hpp"
+#include "Sanitizer.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
@@ -248,7 +249,9 @@ double Mismatch(const VoxelSet& ours, const VoxelSet& truth) {
 // Measured on 2026-12-05 (the same 4 sweeps, 0.2 m): the free voxels of a deskewed sweep, its rays
 // from the ray origins the reader gives (within 2.5 cm of the truth), differ from the true free
 // space by at most 0.33 % of it; with every ray from the sweep's stamp pose, by at least 11 %.
-// Held at about 3x.
+// Held at about 3x. The true free space is integrated column by column (a map update for each of
+// a sweep's ~1800 columns): under a sanitizer, where that took 68 s for the four sweeps, only the
+// first sweep is checked.
 constexpr double kRayOriginMaxMismatch = 0.01;
 constexpr double kStampOriginMinMismatch = 0.05;
 
@@ -258,7 +261,8 @@ TEST(Deskew, RaysStartWhereTheSensorWasWhenItsPointWasMeasured) {
     const core::VoxelMap map = core::VoxelMap::Create(0.2);
     const integration::IntegrationConfig config;
     double worst_ours = 0.0, best_stamp = 1.0;
-    for (size_t k = 0; k < deskewed.size(); ++k) {
+    const size_t sweeps = strata::testing::UnderSanitizer() ? 1 : deskewed.size();
+    for (size_t k = 0; k < sweeps; ++k) {
         core::Scan scan = deskewed.Read(k);
         EXPECT_GT(scan.ray_origins.size(), 2u) << "sweep " << k << ": the sensor moves 1 m";
         const VoxelSet truth = TrueFreeVoxels(street, k, map);
