@@ -54,6 +54,7 @@ struct DistrictConfig {
     double bushes = 0.3;  ///< share of flat facades with a bush in front
     double pole_spacing = 40.0;
     double speed = 10.0, sensor_height = 1.73, lane_offset = 2.5;
+    double corner = 0.0, sway_deg = 0.0;  ///< TrajectorySpec's corner_m and sway_deg
     int every = 10;
     double edits_across = 0.0;  ///< > 0: edits prefer objects across lines x, y = k * this
     std::vector<DistrictSession> sessions;

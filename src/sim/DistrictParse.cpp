@@ -177,6 +177,8 @@ DistrictConfig ReadDistrict(JsonReader& r) {
         c.sensor_height = d.Within("height", c.sensor_height, 0.2, 5.0);
         const double half = 0.5 * c.street_width - 1.0;
         c.lane_offset = d.Within("lane_offset", c.lane_offset, -half, half);
+        c.corner = d.Within("corner", c.corner, 0.0, 50.0);
+        c.sway_deg = d.Within("sway_deg", c.sway_deg, 0.0, 10.0);
         d.Finish();
     }
     c.edits_across = r.Within("edits_across", c.edits_across, 0.0, 1e4);

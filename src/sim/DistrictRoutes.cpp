@@ -114,6 +114,8 @@ void GenerateDistrict(JsonReader& r, SceneAssembler& a) {
               {"speed", c.speed},
               {"every", c.every},
               {"height", c.sensor_height},
+              {"corner", c.corner},
+              {"sway_deg", c.sway_deg},
               {"max_scans", static_cast<int>(std::floor(length / spacing + 1e-9)) + 1}}},
             {"edits", k == 0 ? json::array() : DistrictEdits(c, k, a, plan)}};
         JsonReader sr(session, a.spec().source,

@@ -76,9 +76,13 @@ TrajectorySpec ParseTrajectory(JsonReader& r) {
     t.height_m = r.Get<double>("height", t.height_m);
     t.max_scans = r.Get<int>("max_scans", t.max_scans);
     t.every = r.Get<int>("every", t.every);
+    t.corner_m = r.Get<double>("corner", t.corner_m);
+    t.sway_deg = r.Get<double>("sway_deg", t.sway_deg);
     if (t.waypoints.empty() || !(t.speed_mps > 0.0) || t.max_scans < 1 || t.every < 1) {
         r.Fail("needs waypoints, speed > 0, max_scans >= 1 and every >= 1");
     }
+    if (!(t.corner_m >= 0.0 && t.corner_m <= 100.0)) r.Fail("'corner' must be in [0, 100] m");
+    if (!(t.sway_deg >= 0.0 && t.sway_deg <= 10.0)) r.Fail("'sway_deg' must be in [0, 10]");
     r.Finish();
     return t;
 }

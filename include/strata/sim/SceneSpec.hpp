@@ -19,6 +19,13 @@ struct TrajectorySpec {
     double height_m = 1.73;  ///< sensor above the floor (KITTI's HDL-64E: 1.73 m)
     int max_scans = 30;      ///< scans recorded until the path ends or this cap
     int every = 1;           ///< record every n-th sweep (keyframes), so slow walks stay short
+    /// 0: the path turns at each waypoint and the heading swings within 2 m of it; > 0: the path
+    /// leaves each line this far before the waypoint on a curve whose curvature rises from zero
+    /// and falls back to zero this far after it, as a car steers (sim::PathShape).
+    double corner_m = 0.0;
+    /// Roll and pitch of the sensor swaying on the vehicle's suspension (amplitude, degrees;
+    /// 0: level).
+    double sway_deg = 0.0;
 };
 
 /// @brief A change applied to the scene before a session (relative to the session before).

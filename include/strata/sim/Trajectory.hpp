@@ -16,13 +16,27 @@ struct ScanPose {
     Eigen::Isometry3d T_world_sensor_end = Eigen::Isometry3d::Identity();  ///< one sweep later
 };
 
-/// @brief Constant-speed motion along a polyline of sensor positions. The sensor stays level
-/// and faces along the path; near a corner the heading turns smoothly over `turn_blend_m`.
+/// @brief How a path takes its corners and how the sensor sways (TrajectorySpec's `corner_m`
+/// and `sway_deg`).
+struct PathShape {
+    /// 0: the position turns at each waypoint and the heading swings within 2 m of it. > 0: the
+    /// path leaves each line this far before the waypoint (at most 45 % of either segment) on a
+    /// cubic Bezier curve whose two inner control points are the waypoint, so the curvature
+    /// rises from zero and falls back to zero as when a car steers into a turn and out of it;
+    /// the heading is the curve's.
+    double corner_m = 0.0;
+    /// Amplitude (degrees) of roll and pitch: sines of 23 m and 31 m wavelength (pitch at 0.6 of
+    /// the amplitude), a vehicle on its suspension. 0: the sensor stays level.
+    double sway_deg = 0.0;
+};
+
+/// @brief Constant-speed motion along a polyline of sensor positions, the sensor facing along
+/// the path, its corners and sway as `PathShape` says.
 class Trajectory {
 public:
-    /// @brief Throws InvalidArgumentError for no positions or a speed <= 0.
+    /// @brief Throws InvalidArgumentError for no positions, a speed <= 0 or a negative shape.
     Trajectory(std::vector<Eigen::Vector3d> positions_world, double speed_mps,
-               double turn_blend_m = 2.0);
+               const PathShape& shape = {});
 
     /// @brief Pose at time t (clamped to [0, duration]).
     [[nodiscard]] Eigen::Isometry3d PoseAt(double t_s) const;
@@ -36,7 +50,8 @@ private:
     std::vector<double> arclength_;
     std::vector<double> heading_;  // per segment
     double speed_mps_;
-    double blend_m_;
+    double blend_m_;  // the heading blends linearly across a vertex within this of it
+    double sway_rad_;
     double length_m_ = 0.0;
 };
 
