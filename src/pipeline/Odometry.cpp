@@ -1,6 +1,7 @@
 #include "strata/pipeline/Odometry.hpp"
 
 #include <chrono>
+#include <cstdio>
 
 #include "strata/core/Error.hpp"
 #include "strata/io/PoseFiles.hpp"
@@ -29,6 +30,7 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
                 out.length_m +=
                     (step.T_world_sensor.translation() - out.poses.back().translation()).norm();
             }
+            if (out.poses.empty()) out.ground = step.ground;
             out.poses.push_back(step.T_world_sensor);
             out.times_s.push_back(scan.time_s);
             out.scans.push_back(i);
@@ -38,6 +40,24 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
     if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
+}
+
+std::string DescribeGravity(const EstimatedTrajectory& t) {
+    if (!t.ground) return "gravity: the first scan's z (levelling was off)";
+    const registration::GroundLevel& g = *t.ground;
+    char text[240];
+    if (!g.found) {
+        std::snprintf(text, sizeof(text),
+                      "gravity: no ground plane in the first scan (%s): the map's z is the first "
+                      "scan's",
+                      g.failure.c_str());
+    } else {
+        std::snprintf(text, sizeof(text),
+                      "gravity: the first scan's ground plane (no IMU read): the scan was tilted "
+                      "%.2f deg, %zu returns on the plane, RMS %.3f m, sensor %.2f m above it",
+                      g.tilt_deg, g.points, g.rms_m, g.height_m);
+    }
+    return text;
 }
 
 void RequireTrajectoryFile(const std::filesystem::path& out) {

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "LocalMap.hpp"
 #include "strata/core/Error.hpp"
@@ -30,8 +31,8 @@ constexpr size_t kPointGrain = 256;      // fixed, so the sums do not depend on 
 constexpr double kMinEigenvalue = 0.002;
 // A line of map points within 45 degrees of the vertical is a pole, a trunk or an upright edge;
 // a flatter one is mostly one ring of the sensor's returns on the ground, which moves with the
-// sensor and would hold it back, and is not matched. (The world's z is the first scan's: a
-// sensor mounted level.)
+// sensor and would hold it back, and is not matched. (The world's z is up: the first scan
+// levelled by its ground, or where the caller put it.)
 const double kMinLineZ = std::sqrt(0.5);
 
 // The normal equations of one Gauss-Newton step, summed over the matched points.
@@ -165,11 +166,12 @@ void OdometryConfig::Validate() const {
     require(min_overlap >= 0.0 && min_overlap <= 1.0, "min_overlap must be in [0, 1]");
     require(max_planarity_ratio >= 0.0 && max_planarity_ratio <= 1.0,
             "max_planarity_ratio must be in [0, 1]");
+    ground.Validate();
 }
 
 struct Odometry::State {
     OdometryConfig config;
-    Eigen::Isometry3d T_world_first;
+    std::optional<Eigen::Isometry3d> T_world_first;  // else levelled by the first scan's ground
     detail::LocalMap map;
     std::vector<Eigen::Isometry3d> poses;
     // The motion model's errors (metres, rotation as arc length at max range): their RMS over
@@ -177,13 +179,13 @@ struct Odometry::State {
     double error_squares = 0.0;
     size_t errors = 0;
 
-    State(const OdometryConfig& c, const Eigen::Isometry3d& first)
+    State(const OdometryConfig& c, std::optional<Eigen::Isometry3d> first)
         : config(c),
-          T_world_first(first),
+          T_world_first(std::move(first)),
           map(c.voxel_m, c.max_points_per_voxel, c.max_planarity_ratio) {}
 
     [[nodiscard]] Eigen::Isometry3d Prediction() const {
-        if (poses.empty()) return T_world_first;
+        if (poses.empty()) return T_world_first.value_or(Eigen::Isometry3d::Identity());
         if (poses.size() == 1) return poses.back();
         const Eigen::Isometry3d& a = poses[poses.size() - 2];
         const Eigen::Isometry3d& b = poses.back();
@@ -211,9 +213,9 @@ struct Odometry::State {
     }
 };
 
-Odometry::Odometry(const OdometryConfig& config, const Eigen::Isometry3d& T_world_first) {
+Odometry::Odometry(const OdometryConfig& config, std::optional<Eigen::Isometry3d> T_world_first) {
     config.Validate();
-    state_ = std::make_unique<State>(config, T_world_first);
+    state_ = std::make_unique<State>(config, std::move(T_world_first));
 }
 Odometry::~Odometry() = default;
 Odometry::Odometry(Odometry&&) noexcept = default;
@@ -228,7 +230,17 @@ void Odometry::AddToMap(const std::vector<Eigen::Vector3d>& points_world) {
 }
 
 OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points) {
-    return Register(points, state_->Prediction());
+    const State& s = *state_;
+    if (!s.poses.empty() || s.T_world_first || !s.config.level_from_ground) {
+        return Register(points, s.Prediction());
+    }
+    // The first scan of a world of its own: turned level by its ground.
+    GroundLevel ground = LevelFromGround(points, s.config.ground);
+    Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+    level.linear() = ground.R_level;
+    OdometryStep step = Register(points, level);
+    step.ground = std::move(ground);
+    return step;
 }
 
 OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points,

@@ -1,45 +1,62 @@
 #include "SimulatedDrive.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
-#include <stdexcept>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 
 #include "TempPath.hpp"
 #include "strata/sim/SimulateScene.hpp"
 
 namespace strata::test {
+namespace {
+
+double Yaw(const Eigen::Isometry3d& T) {
+    const Eigen::Vector3d forward = T.linear().col(0);
+    return std::atan2(forward.y(), forward.x());
+}
+
+}  // namespace
 
 size_t SimulatedDrive::Straight() const {
+    const double limit = 5.0 * M_PI / 180.0;
     size_t k = 1;
     while (k < truth.size() &&
-           Eigen::AngleAxisd((truth[k - 1].inverse() * truth[k]).linear()).angle() < 0.1) {
+           std::abs(std::remainder(Yaw(truth[k]) - Yaw(truth.front()), 2.0 * M_PI)) < limit) {
         ++k;
     }
     return k;
 }
 
-const SimulatedDrive& DistrictDrive(size_t max_scans) {
-    static std::map<size_t, SimulatedDrive> drives;
-    auto [it, fresh] = drives.try_emplace(max_scans);
+double SimulatedDrive::Length() const {
+    double length = 0.0;
+    for (size_t k = 1; k < truth.size(); ++k) {
+        length += (truth[k].translation() - truth[k - 1].translation()).norm();
+    }
+    return length;
+}
+
+const SimulatedDrive& DistrictDrive(size_t max_scans, const DriveShape& shape) {
+    static std::map<std::tuple<size_t, double, double>, SimulatedDrive> drives;
+    auto [it, fresh] = drives.try_emplace({max_scans, shape.corner_m, shape.sway_deg});
     if (!fresh) return it->second;
     namespace fs = std::filesystem;
     const fs::path source = fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/district_small.json";
-    std::ifstream in(source);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string json = text.str();
-    const std::string every = "\"every\": 10";
-    const size_t at = json.find(every);
-    if (at == std::string::npos) throw std::runtime_error(source.string() + ": no \"every\": 10");
-    json.replace(at, every.size(), "\"every\": 1");
-    const fs::path scene = TempPath("district_every_metre.json");
-    std::ofstream(scene) << json;
+    nlohmann::json scene = nlohmann::json::parse(std::ifstream(source));
+    nlohmann::json& drive = scene.at("district").at("drive");
+    drive["every"] = 1;
+    drive["corner"] = shape.corner_m;
+    drive["sway_deg"] = shape.sway_deg;
+    const fs::path file =
+        TempPath("district_every_metre_" + std::to_string(max_scans) + "_" +
+                 std::to_string(shape.corner_m) + "_" + std::to_string(shape.sway_deg) + ".json");
+    std::ofstream(file) << scene.dump(1);
     sim::SimulateConfig config;
     config.max_scans = static_cast<int>(max_scans);
-    const sim::SessionSimulation session(sim::LoadSceneSpec(scene), 0, config);
+    const sim::SessionSimulation session(sim::LoadSceneSpec(file), 0, config);
     SimulatedDrive& d = it->second;
     for (size_t k = 0; k < session.size(); ++k) {
         d.sweeps.push_back(session.Sweep(k).scan.points);

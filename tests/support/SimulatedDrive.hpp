@@ -8,16 +8,28 @@
 
 namespace strata::test {
 
+/// @brief How the drive takes its corners and sways (sim::PathShape). The default is the scene
+/// file's: the heading swings 90 degrees within four sweeps at each corner, no vehicle's turn,
+/// and the sensor stays level.
+struct DriveShape {
+    double corner_m = 0.0;
+    double sway_deg = 0.0;
+};
+
 struct SimulatedDrive {
     std::vector<std::vector<Eigen::Vector3d>> sweeps;  ///< sensor frame
     std::vector<Eigen::Isometry3d> truth;              ///< the sweeps' poses
-    /// The sweeps before the first corner (where the route's heading turns 90 degrees within four
-    /// sweeps).
+    /// The sweeps before the heading first turns 5 degrees away from the first sweep's (the
+    /// first street).
     [[nodiscard]] size_t Straight() const;
+    /// The length of the true path from the first sweep to the last, metres.
+    [[nodiscard]] double Length() const;
 };
 
 /// @brief The first `max_scans` sweeps of datasets/scenes/district_small.json's survey drive with
-/// `every` 1 (the scene file has a sweep every 10 m); simulated once per process and size.
-[[nodiscard]] const SimulatedDrive& DistrictDrive(size_t max_scans);
+/// `every` 1 (the scene file has a sweep every 10 m) and `shape`; simulated once per process,
+/// size and shape. The route: 163 m east, a left turn, 81.5 m north, a left turn, 163 m west, a
+/// right turn.
+[[nodiscard]] const SimulatedDrive& DistrictDrive(size_t max_scans, const DriveShape& shape = {});
 
 }  // namespace strata::test

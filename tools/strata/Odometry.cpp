@@ -49,7 +49,8 @@ void Run(OdometryArgs args) {
     std::cout << "odometry: " << t.poses.size() << " of " << source.size() << " scans from "
               << source.Describe() << ", " << t.length_m << " m in " << t.seconds << " s ("
               << 1e3 * t.seconds / static_cast<double>(source.size()) << " ms a scan); poses in "
-              << args.poses_out << "\n";
+              << args.poses_out << "\n"
+              << pipeline::DescribeGravity(t) << "\n";
 }
 
 }  // namespace

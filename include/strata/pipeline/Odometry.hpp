@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,14 @@ struct EstimatedTrajectory {
     std::vector<std::string> skipped;  ///< "scan 12 (<file>): why", with skip_failures
     double seconds = 0.0;
     double length_m = 0.0;  ///< the path's length
+    /// What set the map's z: the first registered scan's ground plane (found or not; see
+    /// registration::OdometryConfig::level_from_ground).
+    std::optional<registration::GroundLevel> ground;
 };
+
+/// @brief One line on where the map's up came from, for the program's output: "gravity: the
+/// first scan's ground plane, ..." or "gravity: none found (...): z is the first scan's".
+[[nodiscard]] std::string DescribeGravity(const EstimatedTrajectory& trajectory);
 
 /// @brief Reads each scan of `source` and registers it.
 /// @throw RefusedError naming the scan and why ("scan 12 (<file>): too little overlap ...")

@@ -5,8 +5,11 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "strata/registration/Gravity.hpp"
 
 namespace strata::registration {
 
@@ -41,6 +44,11 @@ struct OdometryConfig {
     /// lies in a plane's cell is matched to that plane, in an upright line's to that line (the
     /// distance across either); other points are not matched.
     double max_planarity_ratio = 0.1;
+    /// The world's z is up: the first scan is turned level by its ground plane (LevelFromGround)
+    /// when the odometry is not told where the first scan is. Without ground the world is the
+    /// first scan's frame, and the first step says why.
+    bool level_from_ground = true;
+    GroundConfig ground;
 
     /// @brief Throws InvalidArgumentError naming the field when a value is out of range.
     void Validate() const;
@@ -62,14 +70,17 @@ struct OdometryStep {
     /// (rotations scaled to metres at the points' distance): near zero along a direction the
     /// geometry does not constrain, which then keeps the prediction.
     double min_eigenvalue = 0.0;
+    /// The first scan's ground plane, when it levelled the world (or failed to).
+    std::optional<GroundLevel> ground;
 };
 
 /// @brief Scan-to-map odometry with a constant-velocity prediction, an adaptive correspondence
-/// distance and a robust kernel; the first scan defines the world frame.
+/// distance and a robust kernel. The world is where `T_world_first` puts the first scan, else
+/// the first scan's frame turned level (OdometryConfig::level_from_ground).
 class Odometry {
 public:
     explicit Odometry(const OdometryConfig& config = {},
-                      const Eigen::Isometry3d& T_world_first = Eigen::Isometry3d::Identity());
+                      std::optional<Eigen::Isometry3d> T_world_first = std::nullopt);
     ~Odometry();
     Odometry(Odometry&&) noexcept;
     Odometry& operator=(Odometry&&) noexcept;
