@@ -59,6 +59,7 @@ public:
                                        " (numpy): " + step.failure);
                 }
                 scan.T_world_sensor = step.T_world_sensor;
+                if (step.ground) ground_ = step.ground;
             }
             update = session.Integrate(scan);
         }
@@ -76,6 +77,20 @@ public:
         }
         const auto n = static_cast<py::ssize_t>(odometry_->poses().size());
         return ToArray(std::move(flat), {n, 4, 4});
+    }
+
+    // Where the map's up came from (docs/odometry.md, "Gravity"); None without odometry or
+    // before the first scan.
+    [[nodiscard]] py::object Gravity() const {
+        if (!ground_) return py::none();
+        py::dict d;
+        d["source"] = ground_->found ? "ground_plane" : "first_scan";
+        d["tilt_deg"] = ground_->tilt_deg;
+        d["points"] = ground_->points;
+        d["rms_m"] = ground_->rms_m;
+        d["height_m"] = ground_->height_m;
+        d["failure"] = ground_->failure;
+        return d;
     }
 
     py::dict Commit() {
@@ -107,7 +122,8 @@ private:
 
     std::shared_ptr<store::MapStore> store_;  // the writer refers to it: kept alive with it
     std::unique_ptr<pipeline::NewSession> session_;
-    std::optional<registration::Odometry> odometry_;  // odometry=True: poses estimated
+    std::optional<registration::Odometry> odometry_;   // odometry=True: poses estimated
+    std::optional<registration::GroundLevel> ground_;  // what levelled the odometry's world
     std::optional<py::dict> committed_;
 };
 
@@ -123,7 +139,8 @@ void RegisterSession(py::module_& m) {
         .def("commit", &Session::Commit)
         .def("abort", &Session::Abort)
         .def_property_readonly("record", &Session::Record)
-        .def_property_readonly("poses", &Session::Poses);
+        .def_property_readonly("poses", &Session::Poses)
+        .def_property_readonly("gravity", &Session::Gravity);
 }
 
 }  // namespace strata::python

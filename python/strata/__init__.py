@@ -141,8 +141,17 @@ class Session:
     @property
     def poses(self) -> Optional[np.ndarray]:
         """With odometry=True, the poses the odometry found so far, (N, 4, 4) in the first scan's
-        frame (docs/odometry.md); None for a session given its poses."""
+        frame turned level by its ground plane (docs/odometry.md); None for a session given its
+        poses."""
         return self._impl.poses
+
+    @property
+    def gravity(self) -> Optional[dict]:
+        """With odometry=True, where the map's up came from once a scan is in: {"source":
+        "ground_plane" (the first scan's ground) or "first_scan" (none found: the first scan's
+        z), "tilt_deg", "points", "rms_m", "height_m", "failure" (why no ground)}; else None
+        (docs/odometry.md, "Gravity")."""
+        return self._impl.gravity
 
     def commit(self) -> dict:
         """Writes the session in one transaction; returns its record (as Map.sessions())."""

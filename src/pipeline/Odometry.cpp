@@ -1,5 +1,6 @@
 #include "strata/pipeline/Odometry.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -31,6 +32,10 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
                     (step.T_world_sensor.translation() - out.poses.back().translation()).norm();
             }
             if (out.poses.empty()) out.ground = step.ground;
+            if (!step.degenerate.empty()) {
+                out.degenerate.push_back("scan " + std::to_string(i) + " (" + scan.source +
+                                         "): " + step.degenerate);
+            }
             out.poses.push_back(step.T_world_sensor);
             out.times_s.push_back(scan.time_s);
             out.scans.push_back(i);
@@ -40,6 +45,22 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
     if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
+}
+
+std::vector<std::string> OdometryWarnings(const EstimatedTrajectory& t) {
+    constexpr size_t kNamed = 3;  // degenerate scans come in runs: the first few say where
+    std::vector<std::string> lines;
+    for (const std::string& skipped : t.skipped) lines.push_back("left out " + skipped);
+    if (!t.degenerate.empty()) {
+        lines.push_back(std::to_string(t.degenerate.size()) + " of " +
+                        std::to_string(t.poses.size()) +
+                        " scans were degenerate (a motion the matches did not fix kept the "
+                        "prediction); the first:");
+        for (size_t k = 0; k < std::min(kNamed, t.degenerate.size()); ++k) {
+            lines.push_back("  " + t.degenerate[k]);
+        }
+    }
+    return lines;
 }
 
 std::string DescribeGravity(const EstimatedTrajectory& t) {

@@ -68,6 +68,7 @@ void GroundConfig::Validate() const {
     require(max_range_m > kMinRangeM, "max_range_m must be > 0.5");
     require(min_height_m >= 0.0, "min_height_m must be >= 0");
     require(min_points >= 3, "min_points must be >= 3");
+    require(min_share >= 0.0 && min_share <= 1.0, "min_share must be in [0, 1]");
     require(max_rms_m > 0.0, "max_rms_m must be > 0");
 }
 
@@ -123,13 +124,14 @@ GroundLevel LevelFromGround(const std::vector<Eigen::Vector3d>& points, const Gr
         on = Near(near, plane);
     }
     g.points = on.size();
-    if (g.points < c.min_points || plane.n.z() < min_up || plane.d < c.min_height_m ||
-        g.rms_m > c.max_rms_m) {
+    const double share = static_cast<double>(g.points) / static_cast<double>(near.size());
+    if (g.points < c.min_points || share < c.min_share || plane.n.z() < min_up ||
+        plane.d < c.min_height_m || g.rms_m > c.max_rms_m) {
         std::snprintf(text, sizeof(text),
-                      "the best plane (%zu returns, RMS %.3f m, tilted %.1f deg, %.2f m below) "
-                      "is not ground",
-                      g.points, g.rms_m, std::acos(std::min(plane.n.z(), 1.0)) * 180.0 / M_PI,
-                      plane.d);
+                      "the best plane (%zu returns, %.1f %% of those within %.0f m, RMS %.3f m, "
+                      "tilted %.1f deg, %.2f m below) is not ground",
+                      g.points, 100.0 * share, c.max_range_m, g.rms_m,
+                      std::acos(std::min(plane.n.z(), 1.0)) * 180.0 / M_PI, plane.d);
         return Failure(text);
     }
     g.found = true;

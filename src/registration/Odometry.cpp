@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "LocalMap.hpp"
 #include "strata/core/Error.hpp"
@@ -80,22 +82,53 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
 // motion along it). The rotation columns are scaled by the matched points' RMS distance from the
 // sensor, so that both kinds of motion are metres; a direction is unconstrained when its
 // eigenvalue per unit of match weight is below `min_eigenvalue`. Returns the smallest such
-// eigenvalue.
-double SolveConstrained(const Equations& e, double arm_m, double min_eigenvalue, Vector6d* dx) {
+// eigenvalue, and in `weak` the eigenvectors of the unconstrained directions (translation in
+// metres, rotation scaled to metres at the arm).
+double SolveConstrained(const Equations& e, double arm_m, double min_eigenvalue, Vector6d* dx,
+                        std::vector<Vector6d>* weak) {
     Vector6d scale;
     scale << 1, 1, 1, 1.0 / arm_m, 1.0 / arm_m, 1.0 / arm_m;
     const Matrix6d H = scale.asDiagonal() * e.H * scale.asDiagonal() / e.weight;
     const Vector6d g = scale.asDiagonal() * e.g / e.weight;
     const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(H);
     Vector6d step = Vector6d::Zero();
+    weak->clear();
     for (int i = 0; i < 6; ++i) {
         const double lambda = eigen.eigenvalues()(i);
-        if (lambda < min_eigenvalue) continue;
         const Vector6d v = eigen.eigenvectors().col(i);
+        if (lambda < min_eigenvalue) {
+            weak->push_back(v);
+            continue;
+        }
         step -= (v.dot(g) / lambda) * v;
     }
     *dx = scale.asDiagonal() * step;
     return eigen.eigenvalues()(0);
+}
+
+// In words, a motion the matches left to the prediction: `weakest` (world frame) seen from the
+// sensor at T.
+std::string Unconstrained(const Vector6d& weakest, const Eigen::Isometry3d& T) {
+    const bool moves = weakest.head<3>().squaredNorm() >= weakest.tail<3>().squaredNorm();
+    Eigen::Vector3d axis =
+        (T.linear().transpose() * (moves ? weakest.head<3>() : weakest.tail<3>())).normalized();
+    Eigen::Index largest = 0;
+    (void)axis.cwiseAbs().maxCoeff(&largest);
+    if (axis(largest) < 0.0) axis = -axis;  // an eigenvector's sign is free
+    axis = axis.unaryExpr([](double v) { return std::abs(v) < 0.005 ? 0.0 : v; });  // no -0.00
+    char text[80];
+    std::snprintf(text, sizeof(text), "the %s (%.2f, %.2f, %.2f)",
+                  moves ? "motion along" : "rotation about", axis.x(), axis.y(), axis.z());
+    return text;
+}
+
+std::string Degenerate(const std::vector<Vector6d>& weak, const Eigen::Isometry3d& T) {
+    std::string text = "degenerate: the matches do not fix ";
+    for (size_t i = 0; i < weak.size(); ++i) {
+        text += (i == 0 ? "" : " or ") + Unconstrained(weak[i], T);
+    }
+    return text +
+           " of the sensor (a corridor, a tunnel, an open field); the prediction stood there";
 }
 
 // The rigid motion of a small update (translation, rotation vector), applied on the left.
@@ -272,12 +305,13 @@ OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points,
     step.threshold_m = std::min(3.0 * sigma, c.voxel_m);
     Eigen::Isometry3d T = step.T_world_sensor;
     Equations e;
+    std::vector<Vector6d> weak;
     for (step.iterations = 1; step.iterations <= c.max_iterations; ++step.iterations) {
         e = Linearise(s.map, source, T, step.threshold_m, sigma / 3.0);
         if (e.matched < 6) break;
         Vector6d dx;
         step.min_eigenvalue = SolveConstrained(
-            e, std::sqrt(e.arms / static_cast<double>(e.matched)), kMinEigenvalue, &dx);
+            e, std::sqrt(e.arms / static_cast<double>(e.matched)), kMinEigenvalue, &dx, &weak);
         if (!dx.allFinite()) break;
         const Eigen::Translation3d to_sensor(T.translation());
         T = to_sensor * Exp(dx) * to_sensor.inverse() * T;
@@ -306,6 +340,7 @@ OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points,
         step.failure = text;
         return step;
     }
+    if (!weak.empty()) step.degenerate = Degenerate(weak, T);
     s.Learn(step.T_world_sensor, T);
     s.Keep(frame, T);
     step.T_world_sensor = T;

@@ -72,6 +72,7 @@ TEST(Gravity, WithoutGroundNothingIsLevelledAndTheReasonIsGiven) {
     const GroundLevel walls = LevelFromGround(TiltedStreet(Eigen::Matrix3d::Identity(), false));
     // The facades' and the ceiling's returns make no plane that holds as ground: the best one
     // found among them is named and refused.
+    std::printf("%s\n", walls.failure.c_str());
     EXPECT_FALSE(walls.found);
     EXPECT_NE(walls.failure.find("is not ground"), std::string::npos) << walls.failure;
     EXPECT_TRUE(walls.R_level.isIdentity());

@@ -10,11 +10,14 @@
 #include "Sanitizer.hpp"
 #include "SimulatedDrive.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/VoxelMap.hpp"
+#include "strata/integration/Integrator.hpp"
 #include "strata/io/KittiSequence.hpp"
 #include "strata/io/PoseFiles.hpp"
 #include "strata/registration/Odometry.hpp"
 #include "strata/registration/Surface.hpp"
 #include "strata/registration/TrajectoryError.hpp"
+#include "strata/walls/Walls.hpp"
 
 namespace strata::registration {
 namespace {
@@ -119,6 +122,98 @@ TEST(Odometry, DriftOverAKilometreOfTurnsWithPitchAndRoll) {
     EXPECT_LT(d.rotation_deg_per_100m, kMaxRotationDegPer100m);
     EXPECT_LT(ate, kMaxAteM);
     EXPECT_LT(worst_level, kMaxLevelDeg);
+}
+
+// The map the odometry's poses make, against the map of the true poses: the walls the slant
+// analysis finds in both (matched by centroid, the estimate's world moved onto the truth's by the
+// first sweep's two poses) lean alike. The target is 0.1 deg; measured on 2026-12-05 over
+// the first street and the first turn at 0.2 m: 24 walls from the true poses, 22 from ours, 10
+// matched, slants 0.158 deg apart on average and 0.578 at most: the target is missed
+// (docs/odometry.md). Held at about 2x what was measured.
+constexpr size_t kWallSweeps = 200;
+constexpr double kWallVoxelM = 0.2;
+constexpr double kWallMatchM = 1.0;
+constexpr size_t kMinMatchedWalls = 8;
+constexpr double kMaxMeanSlantDifferenceDeg = 0.35;
+constexpr double kMaxSlantDifferenceDeg = 1.2;
+
+TEST(Odometry, TheMapFromItsPosesLeansAsTheTrueMap) {
+    const test::SimulatedDrive& drive = test::DistrictDrive(kWallSweeps, kCarDrive);
+    Odometry odometry;
+    core::VoxelMap truth = core::VoxelMap::Create(kWallVoxelM);
+    core::VoxelMap ours = core::VoxelMap::Create(kWallVoxelM);
+    integration::Integrator into_truth(truth, {}), into_ours(ours, {});
+    for (size_t k = 0; k < drive.sweeps.size(); ++k) {
+        const OdometryStep step = odometry.Register(drive.sweeps[k]);
+        ASSERT_TRUE(step.registered) << "scan " << k << ": " << step.failure;
+        core::Scan scan;
+        scan.points = drive.sweeps[k];
+        scan.T_world_sensor = drive.truth[k];
+        into_truth.Integrate(scan);
+        scan.T_world_sensor = step.T_world_sensor;
+        into_ours.Integrate(scan);
+    }
+    const walls::WallResult true_walls = walls::FindWalls(truth);
+    const walls::WallResult our_walls = walls::FindWalls(ours);
+    const Eigen::Isometry3d onto = drive.truth.front() * odometry.poses().front().inverse();
+    size_t matched = 0;
+    double worst = 0.0, sum = 0.0;
+    for (const walls::Wall& w : our_walls.walls) {
+        const Eigen::Vector3d centroid = onto * w.centroid;
+        const walls::Wall* twin = nullptr;
+        double nearest = kWallMatchM;
+        for (const walls::Wall& v : true_walls.walls) {
+            const double d = (v.centroid - centroid).norm();
+            if (d < nearest) {
+                nearest = d;
+                twin = &v;
+            }
+        }
+        if (twin == nullptr) continue;
+        const double difference = std::abs(w.slant_deg - twin->slant_deg);
+        ++matched;
+        sum += difference;
+        worst = std::max(worst, difference);
+    }
+    std::printf(
+        "walls: %zu from the true poses, %zu from ours, %zu matched; slant differences "
+        "%.4f deg on average, %.4f at most\n",
+        true_walls.walls.size(), our_walls.walls.size(), matched,
+        matched > 0 ? sum / static_cast<double>(matched) : 0.0, worst);
+    ::testing::Test::RecordProperty("max_slant_difference_deg", std::to_string(worst));
+    ASSERT_GE(matched, kMinMatchedWalls);
+    EXPECT_LT(sum / static_cast<double>(matched), kMaxMeanSlantDifferenceDeg);
+    EXPECT_LT(worst, kMaxSlantDifferenceDeg);
+}
+
+// A corridor 4 m wide and 3 m high with nothing along it within range: every sweep sees the same
+// walls, floor and ceiling, so nothing fixes the motion along it. Each scan after the first is
+// registered, flagged degenerate along the corridor (the sensor's x), and keeps the prediction
+// there instead of inventing a motion; the directions the walls do fix stay fixed.
+TEST(Odometry, ACorridorIsFlaggedDegenerateAlongItself) {
+    std::vector<Eigen::Vector3d> sweep;
+    for (double x = -60.0; x <= 60.0; x += 0.2) {
+        for (double u = -1.0; u <= 1.0; u += 0.1) {
+            sweep.emplace_back(x, -2.0, 1.5 * u);  // the walls
+            sweep.emplace_back(x, 2.0, 1.5 * u);
+            sweep.emplace_back(x, 2.0 * u, -1.5);  // floor and ceiling
+            sweep.emplace_back(x, 2.0 * u, 1.5);
+        }
+    }
+    OdometryConfig config;
+    config.level_from_ground = false;  // the floor is level: nothing to learn
+    Odometry odometry(config);
+    ASSERT_TRUE(odometry.Register(sweep).registered);
+    EXPECT_FALSE(odometry.Register(sweep).degenerate.empty());
+    for (int k = 0; k < 3; ++k) {
+        const OdometryStep step = odometry.Register(sweep);
+        ASSERT_TRUE(step.registered) << step.failure;
+        EXPECT_LT(step.min_eigenvalue, 0.002);
+        EXPECT_NE(step.degenerate.find("motion along (1.00, 0.00, 0.00)"), std::string::npos)
+            << step.degenerate;
+        EXPECT_LT(step.T_world_sensor.translation().norm(), 1e-6);
+        EXPECT_LT(Eigen::AngleAxisd(step.T_world_sensor.linear()).angle(), 1e-6);
+    }
 }
 
 TEST(Odometry, AScanFromElsewhereIsRefusedAndChangesNothing) {

@@ -104,8 +104,8 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
     options.ranks = &CommandRanks();
     const pipeline::IntegrateResult r = pipeline::IntegrateSession(args.map, args.scans, options);
     if (r.odometry) {
-        for (const std::string& skipped : r.odometry->skipped) {
-            std::cerr << "strata integrate --odometry: left out " << skipped << "\n";
+        for (const std::string& line : pipeline::OdometryWarnings(*r.odometry)) {
+            std::cerr << "strata integrate --odometry: " << line << "\n";
         }
         std::cout << "odometry: " << r.odometry->poses.size() << " scans posed, "
                   << r.odometry->length_m << " m in " << r.odometry->seconds << " s"

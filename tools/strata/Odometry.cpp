@@ -42,8 +42,8 @@ void Run(OdometryArgs args) {
     const pipeline::ScanSource source =
         pipeline::ScanSource::Open(args.scans, Eigen::Vector3d::Zero());
     const pipeline::EstimatedTrajectory t = pipeline::EstimateTrajectory(source, options);
-    for (const std::string& skipped : t.skipped) {
-        std::cerr << "strata odometry: left out " << skipped << "\n";
+    for (const std::string& line : pipeline::OdometryWarnings(t)) {
+        std::cerr << "strata odometry: " << line << "\n";
     }
     pipeline::WriteTrajectory(args.poses_out, t);
     std::cout << "odometry: " << t.poses.size() << " of " << source.size() << " scans from "

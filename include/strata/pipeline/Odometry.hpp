@@ -30,12 +30,18 @@ struct EstimatedTrajectory {
     std::vector<double> times_s;
     std::vector<size_t> scans;         ///< the source's index of each pose's scan
     std::vector<std::string> skipped;  ///< "scan 12 (<file>): why", with skip_failures
+    /// "scan 12 (<file>): degenerate: ...": registered, a motion kept from the prediction.
+    std::vector<std::string> degenerate;
     double seconds = 0.0;
     double length_m = 0.0;  ///< the path's length
     /// What set the map's z: the first registered scan's ground plane (found or not; see
     /// registration::OdometryConfig::level_from_ground).
     std::optional<registration::GroundLevel> ground;
 };
+
+/// @brief What the program warns of after a run, a line each: the scans left out, and how many
+/// were degenerate with the first few named.
+[[nodiscard]] std::vector<std::string> OdometryWarnings(const EstimatedTrajectory& trajectory);
 
 /// @brief One line on where the map's up came from, for the program's output: "gravity: the
 /// first scan's ground plane, ..." or "gravity: none found (...): z is the first scan's".

@@ -16,8 +16,11 @@ struct GroundConfig {
     /// sensor stands at least `min_height_m` above it.
     double max_range_m = 30.0;
     double min_height_m = 0.3;
-    /// Fewer points than this on the plane, or a plane this rough (RMS), is no ground.
+    /// Fewer points than this on the plane, or a smaller share of the returns within
+    /// `max_range_m` (ground is a third or more of a street's; a slice through two facades that
+    /// happens to be nearly level holds 1-2 %), or a plane this rough (RMS), is no ground.
     size_t min_points = 200;
+    double min_share = 0.1;
     double max_rms_m = 0.05;
 
     /// @brief Throws InvalidArgumentError naming the field when a value is out of range.

@@ -70,6 +70,10 @@ struct OdometryStep {
     /// (rotations scaled to metres at the points' distance): near zero along a direction the
     /// geometry does not constrain, which then keeps the prediction.
     double min_eigenvalue = 0.0;
+    /// Set for a registered scan whose matches left a motion unconstrained (min_eigenvalue below
+    /// 0.002: a corridor, a tunnel, an open field), where the prediction stood: which motion, in
+    /// the sensor's frame, in words.
+    std::string degenerate;
     /// The first scan's ground plane, when it levelled the world (or failed to).
     std::optional<GroundLevel> ground;
 };
