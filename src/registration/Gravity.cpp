@@ -52,6 +52,11 @@ std::vector<Eigen::Vector3d> Near(const std::vector<Eigen::Vector3d>& points, co
     return near;
 }
 
+// Degrees between a plane's upward normal and z.
+double TiltDeg(const Eigen::Vector3d& normal) {
+    return std::acos(std::min(normal.z(), 1.0)) * 180.0 / M_PI;
+}
+
 GroundLevel Failure(const std::string& why) {
     GroundLevel g;
     g.failure = why;
@@ -130,13 +135,12 @@ GroundLevel LevelFromGround(const std::vector<Eigen::Vector3d>& points, const Gr
         std::snprintf(text, sizeof(text),
                       "the best plane (%zu returns, %.1f %% of those within %.0f m, RMS %.3f m, "
                       "tilted %.1f deg, %.2f m below) is not ground",
-                      g.points, 100.0 * share, c.max_range_m, g.rms_m,
-                      std::acos(std::min(plane.n.z(), 1.0)) * 180.0 / M_PI, plane.d);
+                      g.points, 100.0 * share, c.max_range_m, g.rms_m, TiltDeg(plane.n), plane.d);
         return Failure(text);
     }
     g.found = true;
     g.normal = plane.n;
-    g.tilt_deg = std::acos(std::min(plane.n.z(), 1.0)) * 180.0 / M_PI;
+    g.tilt_deg = TiltDeg(plane.n);
     g.height_m = plane.d;
     g.R_level =
         Eigen::Quaterniond::FromTwoVectors(plane.n, Eigen::Vector3d::UnitZ()).toRotationMatrix();

@@ -21,6 +21,11 @@ constexpr double kMaxHeightErrorM = 0.0005;
 // The simulator's HDL-64 sweeps (2 cm range noise) on the district's road: 0.0014-0.0019 deg.
 constexpr double kMaxSweepErrorDeg = 0.005;
 
+// Degrees between two unit vectors.
+double DegreesBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::acos(std::min(1.0, a.dot(b))) / kDeg;
+}
+
 // A street seen from a sensor 1.73 m above it: the road (y in [-7, 7]), sidewalks 0.15 m higher
 // beyond, facades at y = +-11, and a ceiling 3 m above the road over part of it; then the whole
 // scene as a sensor rolled and pitched by `tilt` sees it.
@@ -53,17 +58,18 @@ TEST(Gravity, TheGroundPlaneOfATiltedScanLevelsIt) {
     ASSERT_TRUE(g.found) << g.failure;
     // Up, seen from the sensor, is the tilt's inverse of z.
     const Eigen::Vector3d up = tilt.transpose() * Eigen::Vector3d::UnitZ();
-    const double error = std::acos(std::min(1.0, g.normal.dot(up))) / kDeg;
+    const double error = DegreesBetween(g.normal, up);
     std::printf(
         "normal %.5f deg off, tilt %.4f deg (true %.4f), height %.4f m, %zu returns, "
         "RMS %.4f m\n",
-        error, g.tilt_deg, std::acos(up.z()) / kDeg, g.height_m, g.points, g.rms_m);
+        error, g.tilt_deg, DegreesBetween(up, Eigen::Vector3d::UnitZ()), g.height_m, g.points,
+        g.rms_m);
     EXPECT_LT(error, kMaxNormalErrorDeg);
     EXPECT_NEAR(g.height_m, 1.73, kMaxHeightErrorM);
     EXPECT_GT(g.points, 10000u);  // the road, not the sidewalks or the ceiling
     // Levelled, the sensor's view of up is z, and the heading barely moved (the smallest
     // rotation turns the forward axis by second order in the tilt: 0.052 deg at 3.6 deg).
-    EXPECT_LT(std::acos(std::min(1.0, (g.R_level * up).z())) / kDeg, kMaxNormalErrorDeg);
+    EXPECT_LT(DegreesBetween(g.R_level * up, Eigen::Vector3d::UnitZ()), kMaxNormalErrorDeg);
     const Eigen::Vector3d forward = g.R_level * Eigen::Vector3d::UnitX();
     EXPECT_NEAR(std::atan2(forward.y(), forward.x()), 0.0, 0.1 * kDeg);
 }
@@ -91,9 +97,9 @@ TEST(Gravity, TheSimulatedSweepsGroundGivesItsTilt) {
         const GroundLevel g = LevelFromGround(drive.sweeps[k]);
         ASSERT_TRUE(g.found) << g.failure;
         const Eigen::Vector3d up = drive.truth[k].linear().transpose() * Eigen::Vector3d::UnitZ();
-        const double error = std::acos(std::min(1.0, g.normal.dot(up))) / kDeg;
+        const double error = DegreesBetween(g.normal, up);
         std::printf("sweep %zu: tilted %.3f deg, found %.3f, off by %.4f deg\n", k,
-                    std::acos(up.z()) / kDeg, g.tilt_deg, error);
+                    DegreesBetween(up, Eigen::Vector3d::UnitZ()), g.tilt_deg, error);
         EXPECT_LT(error, kMaxSweepErrorDeg) << k;
     }
 }
