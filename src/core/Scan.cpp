@@ -21,6 +21,10 @@ void Scan::Validate() const {
         throw InvalidArgumentError(where + ": " + std::to_string(intensity.size()) +
                                    " intensities for " + std::to_string(n) + " points");
     }
+    if (!times_s.empty() && times_s.size() != n) {
+        throw InvalidArgumentError(where + ": " + std::to_string(times_s.size()) +
+                                   " point times for " + std::to_string(n) + " points");
+    }
     for (size_t r = 0; r < ray_origins.size(); ++r) {
         const RayOrigin& o = ray_origins[r];
         const bool ordered = r == 0 ? o.begin == 0 : o.begin > ray_origins[r - 1].begin;
@@ -33,6 +37,16 @@ void Scan::Validate() const {
     if (!T_world_sensor.matrix().allFinite()) {
         throw InvalidArgumentError(where + ": the sensor pose is not finite");
     }
+}
+
+Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
+                              double alpha) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = (1.0 - alpha) * a.translation() + alpha * b.translation();
+    const Eigen::AngleAxisd turn(a.linear().transpose() * b.linear());
+    T.linear() =
+        a.linear() * Eigen::AngleAxisd(alpha * turn.angle(), turn.axis()).toRotationMatrix();
+    return T;
 }
 
 }  // namespace strata::core

@@ -26,7 +26,8 @@ IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOpt
     if (options.odometry) {
         // Poses first, written before anything reaches the map: a refusal commits nothing.
         result.odometry = EstimateTrajectory(source, *options.odometry);
-        source = source.Posed(result.odometry->scans, result.odometry->poses);
+        source =
+            source.Posed(result.odometry->scans, result.odometry->poses, result.odometry->times_s);
         if (!options.poses_out.empty()) WriteTrajectory(options.poses_out, *result.odometry);
     }
     session.memory_budget_bytes = static_cast<size_t>(options.memory_budget_mb * 1e6);

@@ -16,7 +16,7 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
     ReportProgress(options.progress, "odometry", 0, source.size());
     for (size_t i = 0; i < source.size(); ++i) {
         const core::Scan scan = source.Read(i);
-        const registration::OdometryStep step = odometry.Register(scan.points);
+        const registration::OdometryStep step = odometry.Register(scan);
         if (!step.registered) {
             const std::string why =
                 "scan " + std::to_string(i) + " (" + scan.source + "): " + step.failure;

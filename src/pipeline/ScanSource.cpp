@@ -1,12 +1,32 @@
 #include "strata/pipeline/ScanSource.hpp"
 
+#include <algorithm>
+
 #include "strata/core/Error.hpp"
 #include "strata/core/FrameRange.hpp"
 #include "strata/io/PoseFiles.hpp"
+#include "strata/recordings/Deskew.hpp"
 
 namespace strata::pipeline {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The trajectory's pose at `t`, interpolated between the poses around it (extrapolated from the
+// first or last two).
+Eigen::Isometry3d PoseAt(const std::vector<double>& times,
+                         const std::vector<Eigen::Isometry3d>& poses, double t) {
+    if (poses.size() == 1) return poses.front();
+    const auto after = std::upper_bound(times.begin(), times.end(), t);
+    const size_t b =
+        std::clamp<size_t>(static_cast<size_t>(after - times.begin()), 1, times.size() - 1);
+    const double dt = times[b] - times[b - 1];
+    const double alpha = dt > 0.0 ? (t - times[b - 1]) / dt : 0.0;
+    return core::Interpolate(poses[b - 1], poses[b], alpha);
+}
+
+}  // namespace
 
 void ScanSpec::Validate() const {
     if (int{!kitti.empty()} + int{!files.empty()} + int{!bag.empty()} != 1) {
@@ -21,6 +41,7 @@ ScanSource ScanSource::Open(const ScanSpec& spec, const Eigen::Vector3d& origin)
     if (!spec.bag.empty()) {
         recordings::RecordedScanOptions options = spec.recording;
         options.frames = spec.frames;
+        options.posed = spec.require_poses;
         return Recording(spec.bag, options);
     }
     io::ReadOptions options;
@@ -42,6 +63,7 @@ ScanSource ScanSource::Recording(const fs::path& bag,
     ScanSource s;
     s.recording_ = std::make_shared<const recordings::RecordedScans>(
         recordings::RecordedScans::Open(bag, options));
+    for (size_t i = 0; i < s.recording_->size(); ++i) s.indices_.push_back(i);
     return s;
 }
 
@@ -62,31 +84,41 @@ ScanSource ScanSource::Files(std::vector<fs::path> files, const fs::path& poses,
     return s;
 }
 
-ScanSource ScanSource::Posed(const std::vector<size_t>& scans,
-                             std::vector<Eigen::Isometry3d> poses) const {
-    if (recording_) throw InvalidArgumentError("a recording's sweeps are posed by its tf tree");
-    if (scans.size() != poses.size()) {
-        throw InvalidArgumentError(std::to_string(poses.size()) + " poses for " +
+ScanSource ScanSource::Posed(const std::vector<size_t>& scans, std::vector<Eigen::Isometry3d> poses,
+                             std::vector<double> times_s) const {
+    if (recording_ && recording_->posed()) {
+        throw InvalidArgumentError("a recording's sweeps are posed by its tf tree");
+    }
+    if (scans.size() != poses.size() || times_s.size() != poses.size()) {
+        throw InvalidArgumentError(std::to_string(poses.size()) + " poses (" +
+                                   std::to_string(times_s.size()) + " instants) for " +
                                    std::to_string(scans.size()) + " scans");
     }
     ScanSource s = *this;
     s.indices_.clear();
     for (const size_t k : scans) s.indices_.push_back(indices_.at(k));
     s.posed_ = std::move(poses);
+    s.posed_times_s_ = std::move(times_s);
     return s;
 }
 
 core::Scan ScanSource::Read(size_t i) const {
-    if (recording_) return recording_->Read(i);
     const size_t k = indices_.at(i);
     core::Scan scan;
-    if (kitti_) {
+    if (recording_) {
+        scan = recording_->Read(k);
+    } else if (kitti_) {
         scan = io::ReadKittiScan(*kitti_, k);
     } else {
         scan = io::ReadPointCloud(files_.at(k), options_);
         if (!poses_.empty()) scan.T_world_sensor = poses_[k];
     }
-    if (!posed_.empty()) scan.T_world_sensor = posed_.at(i);
+    if (posed_.empty()) return scan;
+    scan.T_world_sensor = posed_.at(i);
+    const Eigen::Isometry3d T_stamp_world = scan.T_world_sensor.inverse();
+    recordings::Deskew(scan, [&](double tau) {
+        return Eigen::Isometry3d(T_stamp_world * PoseAt(posed_times_s_, posed_, scan.time_s + tau));
+    });
     return scan;
 }
 

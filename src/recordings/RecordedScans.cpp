@@ -5,23 +5,13 @@
 
 #include "strata/core/Error.hpp"
 #include "strata/core/FrameRange.hpp"
+#include "strata/recordings/Deskew.hpp"
 
 namespace strata::recordings {
 namespace {
 
 constexpr const char* kTf = "/tf";
 constexpr const char* kTfStatic = "/tf_static";
-// Deskewing poses each point by interpolating between poses looked up at most this far apart
-// within its sweep: the trajectory between two tf samples is itself linear, so at 1 ms the
-// interpolation adds well under a millimetre at road speeds.
-constexpr int64_t kDeskewKnotNs = 1000000;
-// A deskewed sweep's rays start where the sensor was at their points' instants, to within this:
-// the sweep is cut into runs of points over which the sensor moves at most twice as far, each
-// with one ray origin in the middle (at 10 m/s about 10 runs to a 0.1 s sweep).
-constexpr double kRayOriginToleranceM = 0.025;
-// A sweep whose points' times span more than this is damaged (spinning LiDARs take 0.05-0.2 s).
-constexpr int64_t kMaxSweepNs = 10LL * 1000000000LL;
-
 std::string TopicList(const RecordingInfo& info, const std::string& type) {
     std::string names;
     for (const Topic& t : info.topics) {
@@ -60,16 +50,6 @@ std::string ChoosePointsTopic(const RecordingInfo& info, const std::string& want
     return clouds.front();
 }
 
-Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
-                              double alpha) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation() = (1.0 - alpha) * a.translation() + alpha * b.translation();
-    T.linear() = Eigen::Quaterniond(a.rotation())
-                     .slerp(alpha, Eigen::Quaterniond(b.rotation()))
-                     .toRotationMatrix();
-    return T;
-}
-
 }  // namespace
 
 RecordedScans RecordedScans::Open(const std::filesystem::path& path,
@@ -82,7 +62,8 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
 
     std::vector<std::string> topics{s.points_topic_};
     if (info.Find(kTfStatic) != nullptr) topics.emplace_back(kTfStatic);
-    if (!options.odom_topic.empty()) {
+    s.posed_ = options.posed;  // else only the sweeps (and /tf_static, the sensor's mounting)
+    if (s.posed_ && !options.odom_topic.empty()) {
         const Topic* odom = info.Find(options.odom_topic);
         if (odom == nullptr) {
             throw NotFoundError(file + ": no topic " + options.odom_topic +
@@ -94,7 +75,7 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
                                        odom->type + ", not nav_msgs/Odometry");
         }
         topics.push_back(options.odom_topic);
-    } else if (info.Find(kTf) != nullptr) {
+    } else if (s.posed_ && info.Find(kTf) != nullptr) {
         topics.emplace_back(kTf);
     }
     std::string odom_frame;
@@ -122,18 +103,56 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
     s.sweeps_ = std::vector<Sweep>(s.sweeps_.begin() + static_cast<std::ptrdiff_t>(begin),
                                    s.sweeps_.begin() + static_cast<std::ptrdiff_t>(end));
 
+    for (size_t i = 0; i < s.sweeps_.size(); ++i) {
+        if (s.sweeps_[i].frame.empty()) {
+            throw FormatError(file + ": " + s.Name(i) + " has no frame_id");
+        }
+    }
+    if (!s.posed_) {
+        // One sensor's sweeps, each in its frame at its stamp: what an odometry chains.
+        s.fixed_frame_ = s.sweeps_.front().frame;
+        for (size_t i = 0; i < s.sweeps_.size(); ++i) {
+            if (s.sweeps_[i].frame != s.fixed_frame_) {
+                throw InvalidArgumentError(file + ": " + s.Name(i) + " is in frame " +
+                                           s.sweeps_[i].frame + ", the first in " + s.fixed_frame_ +
+                                           ": one sensor's sweeps are needed");
+            }
+        }
+        s.times_ = options.deskew;
+        s.deskew_note_ = options.deskew
+                             ? "not posed by the recording: the odometry deskews the sweeps that "
+                               "carry their points' times"
+                             : "not posed by the recording, not deskewed (--no-deskew)";
+        return s;
+    }
     if (s.tree_.Frames().empty()) {
         throw NotFoundError(file + ": no poses: the recording has no /tf" +
                             std::string(options.odom_topic.empty() ? "" : " or odometry") +
-                            " (give poses another way, or wait for strata's odometry)");
+                            " (give poses another way, or estimate them: --odometry)");
     }
     s.fixed_frame_ = !options.fixed_frame.empty() ? options.fixed_frame
                      : !odom_frame.empty()        ? odom_frame
                                                   : s.tree_.Root();
+    // A tree of mountings alone poses every sweep at one place: a sensor that stood still, or
+    // (far more often) a recording whose trajectory was never recorded.
+    size_t poses = SIZE_MAX;
+    bool moving = false;
+    for (const TransformTree::EdgeSummary& e :
+         s.tree_.EdgesBetween(s.fixed_frame_, s.sweeps_.front().frame)) {
+        if (e.is_static) continue;
+        moving = true;
+        poses = std::min(poses, e.samples);
+    }
+    if (!moving && s.sweeps_.size() > 1) {
+        throw NotFoundError(file +
+                            ": no trajectory: the tf tree holds only fixed transforms from " +
+                            s.fixed_frame_ + " to " + s.sweeps_.front().frame +
+                            " (/tf_static), so every sweep would lie at one pose (estimate the "
+                            "poses: --odometry)");
+    }
     // Every sweep posed at its stamp, checked now: a refusal comes before anything is written.
     for (size_t i = 0; i < s.sweeps_.size(); ++i) {
         const Sweep& w = s.sweeps_[i];
-        if (w.frame.empty()) throw FormatError(file + ": " + s.Name(i) + " has no frame_id");
         const auto span = s.tree_.Span(s.fixed_frame_, w.frame);
         if (span && (w.stamp_ns < span->first || w.stamp_ns > span->second)) {
             throw RefusedError(file + ": " + s.Name(i) + " lies outside the trajectory from " +
@@ -158,14 +177,6 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
             "not deskewed: the clouds have no per-point time field (t, time, timestamp or "
             "offset_time)";
         return s;
-    }
-    size_t poses = SIZE_MAX;
-    bool moving = false;
-    for (const TransformTree::EdgeSummary& e :
-         s.tree_.EdgesBetween(s.fixed_frame_, s.sweeps_.front().frame)) {
-        if (e.is_static) continue;
-        moving = true;
-        poses = std::min(poses, e.samples);
     }
     if (!moving) {
         s.deskew_note_ = "not deskewed: the sensor does not move in " + s.fixed_frame_;
@@ -196,79 +207,30 @@ core::Scan RecordedScans::Read(size_t i) const {
     recording_->ReadMessage(w.location,
                             [&](const Message& m) { cloud = DecodePointCloud2(m, file); });
     core::Scan scan;
-    scan.T_world_sensor = tree_.Lookup(fixed_frame_, w.frame, w.stamp_ns);
+    if (posed_) scan.T_world_sensor = tree_.Lookup(fixed_frame_, w.frame, w.stamp_ns);
     scan.time_s = static_cast<double>(w.stamp_ns) * 1e-9;
     scan.source = file + ": " + Name(i);
-    if (!deskew_ || cloud.time_ns.empty()) {
-        scan.intensity = std::move(cloud.intensity);
-        scan.points = std::move(cloud.points);
+    scan.intensity = std::move(cloud.intensity);
+    scan.points = std::move(cloud.points);
+    if (!deskew_ && !times_) return scan;
+    scan.times_s.reserve(cloud.time_ns.size());
+    for (const int64_t t : cloud.time_ns) {
+        scan.times_s.push_back(static_cast<float>(static_cast<double>(t - w.stamp_ns) * 1e-9));
+    }
+    if (!deskew_) {
+        RequireSweepTimes(scan);
         return scan;
     }
-    // Poses of the sensor relative to its pose at the stamp, at knots across the sweep.
-    const auto [lo, hi] = std::minmax_element(cloud.time_ns.begin(), cloud.time_ns.end());
-    const int64_t t0 = *lo, span = *hi - *lo;
-    if (span < 0 || span > kMaxSweepNs) {
-        throw FormatError(file + ": " + Name(i) + ": its points' times span " + FormatStamp(span) +
-                          " s; a sweep takes a fraction of a second");
-    }
-    const size_t knots = static_cast<size_t>(span / kDeskewKnotNs) + 2;
     const Eigen::Isometry3d T_stamp_world = scan.T_world_sensor.inverse();
-    std::vector<Eigen::Isometry3d> relative(knots);
-    for (size_t k = 0; k < knots; ++k) {
-        const int64_t t = t0 + static_cast<int64_t>(
-                                   std::llround(static_cast<double>(span) * static_cast<double>(k) /
-                                                static_cast<double>(knots - 1)));
+    Deskew(scan, [&](double tau) {
+        const int64_t t = w.stamp_ns + std::llround(tau * 1e9);
         try {
-            relative[k] = T_stamp_world * tree_.Lookup(fixed_frame_, w.frame, t);
+            return Eigen::Isometry3d(T_stamp_world * tree_.Lookup(fixed_frame_, w.frame, t));
         } catch (const RefusedError& e) {
             throw RefusedError(file + ": " + Name(i) + ": its points' times reach " +
                                FormatStamp(t) + ": " + e.what());
         }
-    }
-    // Runs of knot intervals over which the sensor moves at most twice the tolerance.
-    std::vector<size_t> run_of(knots - 1);
-    for (size_t a = 0; a + 1 < knots;) {
-        size_t b = a + 1;
-        while (b + 1 < knots &&
-               (relative[b + 1].translation() - relative[a].translation()).norm() <=
-                   2.0 * kRayOriginToleranceM) {
-            ++b;
-        }
-        std::fill(run_of.begin() + static_cast<ptrdiff_t>(a),
-                  run_of.begin() + static_cast<ptrdiff_t>(b), scan.ray_origins.size());
-        scan.ray_origins.push_back(
-            {0, 0.5 * (relative[a].translation() + relative[b].translation())});
-        a = b;
-    }
-    // The points deskewed, then stably ordered by run (a counting sort).
-    const size_t n = cloud.points.size();
-    std::vector<size_t> run(n);
-    std::vector<size_t> count(scan.ray_origins.size() + 1, 0);
-    std::vector<Eigen::Vector3d> points(n);
-    const double scale =
-        span > 0 ? static_cast<double>(knots - 1) / static_cast<double>(span) : 0.0;
-    for (size_t j = 0; j < n; ++j) {
-        const double u = static_cast<double>(cloud.time_ns[j] - t0) * scale;
-        const size_t k = std::min(static_cast<size_t>(u), knots - 2);
-        points[j] =
-            Interpolate(relative[k], relative[k + 1], u - static_cast<double>(k)) * cloud.points[j];
-        run[j] = run_of[k];
-        ++count[run[j] + 1];
-    }
-    std::vector<core::RayOrigin> origins;
-    for (size_t r = 0; r < scan.ray_origins.size(); ++r) {
-        // Runs no point fell into (a gap in the sweep's times) are left out.
-        if (count[r + 1] > 0) origins.push_back({count[r], scan.ray_origins[r].origin});
-        count[r + 1] += count[r];
-    }
-    scan.ray_origins = std::move(origins);
-    scan.points.resize(n);
-    scan.intensity.resize(cloud.intensity.size());
-    for (size_t j = 0; j < n; ++j) {
-        const size_t to = count[run[j]]++;
-        scan.points[to] = points[j];
-        if (!cloud.intensity.empty()) scan.intensity[to] = cloud.intensity[j];
-    }
+    });
     return scan;
 }
 

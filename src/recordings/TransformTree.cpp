@@ -4,6 +4,7 @@
 #include <set>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/Scan.hpp"
 
 namespace strata::recordings {
 namespace {
@@ -117,12 +118,7 @@ Eigen::Isometry3d TransformTree::At(const std::string& child, const Edge& edge,
     const auto before = after - 1;
     const double alpha = static_cast<double>(t_ns - before->first) /
                          static_cast<double>(after->first - before->first);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation() =
-        (1.0 - alpha) * before->second.translation() + alpha * after->second.translation();
-    const Eigen::Quaterniond q0(before->second.rotation()), q1(after->second.rotation());
-    T.linear() = q0.slerp(alpha, q1).toRotationMatrix();
-    return T;
+    return core::Interpolate(before->second, after->second, alpha);
 }
 
 Eigen::Isometry3d TransformTree::Lookup(const std::string& fixed, const std::string& frame,

@@ -6,6 +6,7 @@
 #include "strata/registration/Odometry.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -131,6 +132,37 @@ std::string Degenerate(const std::vector<Vector6d>& weak, const Eigen::Isometry3
            " of the sensor (a corridor, a tunnel, an open field); the prediction stood there";
 }
 
+// The points of a sweep, each measured `times[j]` seconds after the stamp, moved into the
+// sensor's frame at the stamp, the sensor moving by `delta` every `interval` seconds (its motion
+// from the scan before). The motion is evaluated at knots a millisecond apart and each point moved
+// by the two around its instant, blended.
+std::vector<Eigen::Vector3d> Deskewed(const std::vector<Eigen::Vector3d>& points,
+                                      const std::vector<float>& times,
+                                      const Eigen::Isometry3d& delta, double interval) {
+    constexpr double kKnotS = 1e-3;
+    const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
+    const double t0 = *lo, span = static_cast<double>(*hi) - t0;
+    const size_t knots = static_cast<size_t>(span / kKnotS) + 2;
+    std::vector<Eigen::Isometry3d> at(knots);
+    for (size_t k = 0; k < knots; ++k) {
+        const double t = t0 + span * static_cast<double>(k) / static_cast<double>(knots - 1);
+        at[k] = core::Interpolate(Eigen::Isometry3d::Identity(), delta, t / interval);
+    }
+    const double scale = span > 0.0 ? static_cast<double>(knots - 1) / span : 0.0;
+    std::vector<Eigen::Vector3d> out(points.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t j = r.begin(); j != r.end(); ++j) {
+                              const double u = (static_cast<double>(times[j]) - t0) * scale;
+                              const size_t k = std::min(static_cast<size_t>(u), knots - 2);
+                              const double f = u - static_cast<double>(k);
+                              out[j] =
+                                  (1.0 - f) * (at[k] * points[j]) + f * (at[k + 1] * points[j]);
+                          }
+                      });
+    return out;
+}
+
 // The rigid motion of a small update (translation, rotation vector), applied on the left.
 Eigen::Isometry3d Exp(const Vector6d& dx) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -207,6 +239,13 @@ struct Odometry::State {
     std::optional<Eigen::Isometry3d> T_world_first;  // else levelled by the first scan's ground
     detail::LocalMap map;
     std::vector<Eigen::Isometry3d> poses;
+    std::vector<double> stamps;  // their instants, NaN when unknown
+    // The first scan as measured, kept while it is the map's only scan: once the second gives
+    // a velocity, the map restarts from it deskewed.
+    struct {
+        std::vector<Eigen::Vector3d> points;
+        std::vector<float> times;
+    } first_sweep;
     // The motion model's errors (metres, rotation as arc length at max range): their RMS over
     // the scans that moved sets the correspondence distance.
     double error_squares = 0.0;
@@ -217,12 +256,25 @@ struct Odometry::State {
           T_world_first(std::move(first)),
           map(c.voxel_m, c.max_points_per_voxel, c.max_planarity_ratio) {}
 
-    [[nodiscard]] Eigen::Isometry3d Prediction() const {
+    // The sensor's motion from the pose before the last to the last (the identity before two
+    // poses), and the seconds it took (0 when an instant is unknown: the scans at a steady
+    // rate).
+    [[nodiscard]] Eigen::Isometry3d LastMotion(double* interval) const {
+        *interval = 0.0;
+        if (poses.size() < 2) return Eigen::Isometry3d::Identity();
+        const double ta = stamps[stamps.size() - 2], tb = stamps.back();
+        if (tb > ta) *interval = tb - ta;  // false for NaN
+        return poses[poses.size() - 2].inverse() * poses.back();
+    }
+    // The pose at instant `t` (NaN: the next scan at the steady rate) at the last motion's
+    // velocity.
+    [[nodiscard]] Eigen::Isometry3d Prediction(double t) const {
         if (poses.empty()) return T_world_first.value_or(Eigen::Isometry3d::Identity());
-        if (poses.size() == 1) return poses.back();
-        const Eigen::Isometry3d& a = poses[poses.size() - 2];
-        const Eigen::Isometry3d& b = poses.back();
-        return b * (a.inverse() * b);
+        double interval = 0.0;
+        const Eigen::Isometry3d delta = LastMotion(&interval);
+        if (interval == 0.0 || !std::isfinite(t)) return poses.back() * delta;
+        return poses.back() * core::Interpolate(Eigen::Isometry3d::Identity(), delta,
+                                                (t - stamps.back()) / interval);
     }
     [[nodiscard]] double Sigma() const {
         return errors == 0 ? config.initial_threshold_m
@@ -237,13 +289,29 @@ struct Odometry::State {
         error_squares += error * error;
         ++errors;
     }
-    void Keep(const std::vector<Eigen::Vector3d>& frame, const Eigen::Isometry3d& T) {
+    void Keep(const std::vector<Eigen::Vector3d>& frame, const Eigen::Isometry3d& T, double t) {
         std::vector<Eigen::Vector3d> world(frame.size());
         for (size_t i = 0; i < frame.size(); ++i) world[i] = T * frame[i];
         map.Add(world);
         map.RemoveFarFrom(T.translation(), config.max_range_m);
         poses.push_back(T);
+        stamps.push_back(t);
     }
+    // A scan's points within range, thinned to one per half cell: what joins the map.
+    [[nodiscard]] std::vector<Eigen::Vector3d> Thinned(
+        const std::vector<Eigen::Vector3d>& points) const {
+        return Downsample(points, kMapThinning * config.voxel_m, config.min_range_m,
+                          config.max_range_m);
+    }
+    // Gauss-Newton from `T` of `frame` (thinned once more) against the map; fills `step`'s
+    // figures (points, matches at the end, RMSE, threshold, iterations, eigenvalue, degenerate)
+    // and returns the pose found.
+    Eigen::Isometry3d Align(const std::vector<Eigen::Vector3d>& frame, Eigen::Isometry3d T,
+                            OdometryStep* step) const;
+    // Registers the next scan (Odometry::Register), its points' times and instant when known.
+    OdometryStep Register(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<float>* times, double t,
+                          std::optional<Eigen::Isometry3d> guess);
 };
 
 Odometry::Odometry(const OdometryConfig& config, std::optional<Eigen::Isometry3d> T_world_first) {
@@ -263,54 +331,35 @@ void Odometry::AddToMap(const std::vector<Eigen::Vector3d>& points_world) {
 }
 
 OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points) {
-    const State& s = *state_;
-    if (!s.poses.empty() || s.T_world_first || !s.config.level_from_ground) {
-        return Register(points, s.Prediction());
-    }
-    // The first scan of a world of its own: turned level by its ground.
-    GroundLevel ground = LevelFromGround(points, s.config.ground);
-    Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
-    level.linear() = ground.R_level;
-    OdometryStep step = Register(points, level);
-    step.ground = std::move(ground);
-    return step;
+    return state_->Register(points, nullptr, std::nan(""), std::nullopt);
+}
+
+OdometryStep Odometry::Register(const core::Scan& scan) {
+    return state_->Register(scan.points, &scan.times_s, scan.time_s, std::nullopt);
 }
 
 OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points,
                                 const Eigen::Isometry3d& guess) {
-    State& s = *state_;
-    const OdometryConfig& c = s.config;
-    const std::vector<Eigen::Vector3d> frame =
-        Downsample(points, kMapThinning * c.voxel_m, c.min_range_m, c.max_range_m);
-    const std::vector<Eigen::Vector3d> source = Downsample(frame, kSourceThinning * c.voxel_m);
-    OdometryStep step;
-    step.T_world_sensor = guess;
-    step.points = source.size();
-    if (s.map.empty()) {  // the first scan: the map starts in its frame
-        if (frame.empty()) {
-            char text[120];
-            std::snprintf(text, sizeof(text), "no points between %.1f and %.1f m to start from",
-                          c.min_range_m, c.max_range_m);
-            step.failure = text;
-            return step;
-        }
-        s.Keep(frame, step.T_world_sensor);
-        step.registered = true;
-        return step;
-    }
+    return state_->Register(points, nullptr, std::nan(""), guess);
+}
+
+Eigen::Isometry3d Odometry::State::Align(const std::vector<Eigen::Vector3d>& frame,
+                                         Eigen::Isometry3d T, OdometryStep* step) const {
+    const std::vector<Eigen::Vector3d> source = Downsample(frame, kSourceThinning * config.voxel_m);
+    step->points = source.size();
     // Matches within three deviations of the motion model, and never beyond one cell: a shape
     // holds only around where it was fitted (farther, the point's own surface may be another, a
     // facade that ended), so nothing is learnt from a farther match.
-    const double sigma = s.Sigma();
-    step.threshold_m = std::min(3.0 * sigma, c.voxel_m);
-    Eigen::Isometry3d T = step.T_world_sensor;
+    const double sigma = Sigma();
+    step->threshold_m = std::min(3.0 * sigma, config.voxel_m);
     Equations e;
     std::vector<Vector6d> weak;
-    for (step.iterations = 1; step.iterations <= c.max_iterations; ++step.iterations) {
-        e = Linearise(s.map, source, T, step.threshold_m, sigma / 3.0);
+    int iterations = 1;
+    for (; iterations <= config.max_iterations; ++iterations) {
+        e = Linearise(map, source, T, step->threshold_m, sigma / 3.0);
         if (e.matched < 6) break;
         Vector6d dx;
-        step.min_eigenvalue = SolveConstrained(
+        step->min_eigenvalue = SolveConstrained(
             e, std::sqrt(e.arms / static_cast<double>(e.matched)), kMinEigenvalue, &dx, &weak);
         if (!dx.allFinite()) break;
         const Eigen::Translation3d to_sensor(T.translation());
@@ -318,31 +367,88 @@ OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points,
         // Products of rotations drift from orthonormal in the last bits; a scan's poses are
         // products of thousands of them by the end of a drive.
         T.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
-        if (dx.norm() < c.convergence) break;
+        if (dx.norm() < config.convergence) break;
     }
-    step.iterations = std::min(step.iterations, c.max_iterations);
-    e = Linearise(s.map, source, T, step.threshold_m, sigma / 3.0);  // where it ended
-    step.correspondences = e.matched;
-    step.rmse_m = e.matched > 0 ? std::sqrt(e.squared / static_cast<double>(e.matched)) : 0.0;
-    const double overlap =
-        source.empty() ? 0.0 : static_cast<double>(e.matched) / static_cast<double>(source.size());
+    step->iterations += std::min(iterations, config.max_iterations);
+    e = Linearise(map, source, T, step->threshold_m, sigma / 3.0);  // where it ended
+    step->correspondences = e.matched;
+    step->rmse_m = e.matched > 0 ? std::sqrt(e.squared / static_cast<double>(e.matched)) : 0.0;
+    step->degenerate = weak.empty() ? std::string() : Degenerate(weak, T);
+    return T;
+}
+
+OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<float>* times, double t,
+                                       std::optional<Eigen::Isometry3d> guess) {
+    const OdometryConfig& c = config;
+    std::optional<GroundLevel> ground;
+    if (!guess && poses.empty() && !T_world_first && c.level_from_ground) {
+        // The first scan of a world of its own: turned level by its ground.
+        ground = LevelFromGround(points, c.ground);
+        guess = Eigen::Isometry3d::Identity();
+        guess->linear() = ground->R_level;
+    }
+    // A sweep measured while moving is deskewed at the motion model's velocity, registered,
+    // deskewed again at the velocity it was found to have, and registered once more from there.
+    const bool timed = times != nullptr && !times->empty() && std::isfinite(t);
+    double interval = 0.0;
+    const Eigen::Isometry3d delta = LastMotion(&interval);
+    std::vector<Eigen::Vector3d> frame =
+        Thinned(timed && interval > 0.0 ? Deskewed(points, *times, delta, interval) : points);
+    OdometryStep step;
+    step.ground = std::move(ground);
+    step.T_world_sensor = guess.value_or(Prediction(t));
+    if (map.empty()) {  // the first scan: the map starts in its frame
+        step.points = frame.size();
+        if (frame.empty()) {
+            char text[120];
+            std::snprintf(text, sizeof(text), "no points between %.1f and %.1f m to start from",
+                          c.min_range_m, c.max_range_m);
+            step.failure = text;
+            return step;
+        }
+        Keep(frame, step.T_world_sensor, t);
+        if (timed) first_sweep = {points, *times};  // deskewed once a velocity is known
+        step.registered = true;
+        return step;
+    }
+    Eigen::Isometry3d T = Align(frame, step.T_world_sensor, &step);
+    const double since = poses.empty() ? 0.0 : t - stamps.back();
+    if (timed && since > 0.0 && T.matrix().allFinite()) {
+        const Eigen::Isometry3d found = poses.back().inverse() * T;
+        if (!first_sweep.points.empty()) {
+            // The map's first sweep, measured while moving too, deskewed at this velocity.
+            const Eigen::Isometry3d first = poses.back();
+            map = detail::LocalMap(c.voxel_m, c.max_points_per_voxel, c.max_planarity_ratio);
+            poses.pop_back();
+            stamps.pop_back();
+            Keep(Thinned(Deskewed(first_sweep.points, first_sweep.times, found, since)), first,
+                 t - since);
+            first_sweep = {};
+        }
+        frame = Thinned(Deskewed(points, *times, found, since));
+        T = Align(frame, T, &step);
+    }
     if (!T.matrix().allFinite()) {
         step.failure = "the registration diverged (a pose that is not finite)";
         return step;
     }
-    if (e.matched < static_cast<size_t>(c.min_correspondences) || overlap < c.min_overlap) {
+    const double overlap = step.points == 0 ? 0.0
+                                            : static_cast<double>(step.correspondences) /
+                                                  static_cast<double>(step.points);
+    if (step.correspondences < static_cast<size_t>(c.min_correspondences) ||
+        overlap < c.min_overlap) {
         char text[200];
         std::snprintf(text, sizeof(text),
                       "too little overlap with the map: %zu of %zu points matched within %.2f m "
                       "(needs %d and %.0f %%)",
-                      e.matched, source.size(), step.threshold_m, c.min_correspondences,
+                      step.correspondences, step.points, step.threshold_m, c.min_correspondences,
                       100.0 * c.min_overlap);
         step.failure = text;
         return step;
     }
-    if (!weak.empty()) step.degenerate = Degenerate(weak, T);
-    s.Learn(step.T_world_sensor, T);
-    s.Keep(frame, T);
+    Learn(step.T_world_sensor, T);
+    Keep(frame, T, t);
     step.T_world_sensor = T;
     step.registered = true;
     return step;

@@ -6,18 +6,15 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <fstream>
 #include <set>
 #include <tuple>
 
 #include "BagFixtures.hpp"
+#include "MovingStreet.hpp"
 #include "Sanitizer.hpp"
 #include "strata/integration/Integrator.hpp"
-#include "strata/io/KittiSequence.hpp"
-#include "strata/io/PoseFiles.hpp"
 #include "strata/pipeline/Export.hpp"
 #include "strata/recordings/RecordedScans.hpp"
-#include "strata/sim/SimulateScene.hpp"
 
 namespace strata::recordings::test {
 namespace {
@@ -31,74 +28,10 @@ constexpr double kDeskewedMaxErrorM = 1.5e-7;
 constexpr double kSkewedMinMedianErrorM = 0.25;
 constexpr double kSkewedMinStray = 0.2;
 
-// The simulator's pose a fraction s through a sweep (src/sim/SweepSimulation.cpp).
-Eigen::Isometry3d Between(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double s) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() =
-        Eigen::Quaterniond(a.linear()).slerp(s, Eigen::Quaterniond(b.linear())).toRotationMatrix();
-    T.translation() = (1.0 - s) * a.translation() + s * b.translation();
-    return T;
-}
-
-struct MovingSweeps {
-    fs::path bag;
-    std::vector<std::vector<Eigen::Vector3d>> truth;   // per sweep, world points as simulated
-    std::vector<std::vector<Eigen::Vector3d>> origin;  // per sweep, each point's ray origin
-};
-
-// Four sweeps of the street in motion, written as a KITTI-layout folder with per-point times and
-// end poses, and then as a bag by python3-rosbag.
+// Four sweeps of the street in motion (VLP-16), as a bag with a dense /tf (MovingStreet.hpp).
 const MovingSweeps& Street() {
-    static const MovingSweeps sweeps = [] {
-        const sim::SceneSpec spec =
-            sim::LoadSceneSpec(fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/street.json");
-        sim::SimulateConfig config;
-        config.motion = true;
-        config.sensor = "vlp16";
-        config.max_scans = 4;
-        const sim::SessionSimulation session(spec, 0, config);
-        const fs::path dir = strata::test::TempPath("deskew_street");
-        fs::create_directories(dir / "velodyne");
-        MovingSweeps out;
-        std::vector<Eigen::Isometry3d> starts, ends;
-        std::ofstream times(dir / "times.txt");
-        for (size_t k = 0; k < session.size(); ++k) {
-            const sim::SimulatedScan s = session.Sweep(k);
-            const Eigen::Isometry3d start = session.T_session_sensor(k);
-            const Eigen::Isometry3d session_world =
-                start * session.poses()[k].T_world_sensor.inverse();
-            const Eigen::Isometry3d end = session_world * session.poses()[k].T_world_sensor_end;
-            starts.push_back(start);
-            ends.push_back(end);
-            times << session.poses()[k].time_s << "\n";
-            char name[32];
-            std::snprintf(name, sizeof(name), "%06zu", k);
-            io::WriteKittiBin(dir / "velodyne" / (std::string(name) + ".bin"), s.scan.points);
-            std::vector<float> dt(s.scan.points.size());
-            std::vector<Eigen::Vector3d> world(s.scan.points.size()), origin(world.size());
-            for (size_t j = 0; j < dt.size(); ++j) {
-                const double t = session.sensor().ColumnTimeS(s.column[j]);
-                dt[j] = static_cast<float>(t);
-                // The point as written (float32), where the simulator's pose put it.
-                const Eigen::Vector3d p = s.scan.points[j].cast<float>().cast<double>();
-                const Eigen::Isometry3d pose = Between(start, end, t * session.sensor().rate_hz);
-                world[j] = pose * p;
-                origin[j] = pose.translation();
-            }
-            std::ofstream(dir / "velodyne" / (std::string(name) + ".time"), std::ios::binary)
-                .write(reinterpret_cast<const char*>(dt.data()),
-                       static_cast<std::streamsize>(dt.size() * sizeof(float)));
-            out.truth.push_back(std::move(world));
-            out.origin.push_back(std::move(origin));
-        }
-        io::WriteKittiPoses(dir / "poses.txt", starts);
-        io::WriteKittiPoses(dir / "end_poses.txt", ends);
-        times.close();
-        out.bag = WriteRos1Bag(
-            dir, "deskew_street",
-            "--point-time time --tf-rate 20 --motion " + (dir / "end_poses.txt").string());
-        return out;
-    }();
+    static const MovingSweeps sweeps =
+        WriteMovingStreet("vlp16", 4, 3, "deskew_street", "--point-time time --tf-rate 20");
     return sweeps;
 }
 

@@ -40,8 +40,9 @@ double SimulatedDrive::Length() const {
 }
 
 const SimulatedDrive& DistrictDrive(size_t max_scans, const DriveShape& shape) {
-    static std::map<std::tuple<size_t, double, double>, SimulatedDrive> drives;
-    auto [it, fresh] = drives.try_emplace({max_scans, shape.corner_m, shape.sway_deg});
+    static std::map<std::tuple<size_t, double, double, bool>, SimulatedDrive> drives;
+    auto [it, fresh] =
+        drives.try_emplace({max_scans, shape.corner_m, shape.sway_deg, shape.motion});
     if (!fresh) return it->second;
     namespace fs = std::filesystem;
     const fs::path source = fs::path(STRATA_SOURCE_DIR) / "datasets/scenes/district_small.json";
@@ -56,11 +57,20 @@ const SimulatedDrive& DistrictDrive(size_t max_scans, const DriveShape& shape) {
     std::ofstream(file) << scene.dump(1);
     sim::SimulateConfig config;
     config.max_scans = static_cast<int>(max_scans);
+    config.motion = shape.motion;
     const sim::SessionSimulation session(sim::LoadSceneSpec(file), 0, config);
     SimulatedDrive& d = it->second;
     for (size_t k = 0; k < session.size(); ++k) {
-        d.sweeps.push_back(session.Sweep(k).scan.points);
+        sim::SimulatedScan sweep = session.Sweep(k);
+        if (shape.motion) {
+            std::vector<float>& times = d.times.emplace_back();
+            for (const auto column : sweep.column) {
+                times.push_back(static_cast<float>(session.sensor().ColumnTimeS(column)));
+            }
+        }
+        d.sweeps.push_back(std::move(sweep.scan.points));
         d.truth.push_back(session.T_session_sensor(k));
+        d.stamps.push_back(session.poses()[k].time_s);
     }
     return d;
 }

@@ -14,11 +14,17 @@ namespace strata::test {
 struct DriveShape {
     double corner_m = 0.0;
     double sway_deg = 0.0;
+    /// Each sweep measured while driving (a spinning sensor's columns from the pose of their
+    /// own instant over 0.1 s): SimulatedDrive::times says when.
+    bool motion = false;
 };
 
 struct SimulatedDrive {
     std::vector<std::vector<Eigen::Vector3d>> sweeps;  ///< sensor frame
-    std::vector<Eigen::Isometry3d> truth;              ///< the sweeps' poses
+    std::vector<Eigen::Isometry3d> truth;              ///< the sweeps' poses at their stamps
+    std::vector<double> stamps;                        ///< seconds, 0.1 apart
+    /// With DriveShape::motion, each point's time after its sweep's stamp (seconds); else empty.
+    std::vector<std::vector<float>> times;
     /// The sweeps before the heading first turns 5 degrees away from the first sweep's (the
     /// first street).
     [[nodiscard]] size_t Straight() const;

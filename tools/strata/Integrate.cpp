@@ -62,11 +62,13 @@ void PrintStart(const pipeline::IntegrationStart& s, const IntegrateArgs& args) 
               << (config.keep_point_means ? "" : ", no point means") << ", threads "
               << (args.threads > 0 ? std::to_string(args.threads) : "all") << "\n";
     if (const recordings::RecordedScans* r = s.source.recording()) {
-        std::cerr << "strata integrate: sweeps of " << r->points_topic() << " posed in "
-                  << r->fixed_frame() << ", " << r->deskew_note() << "\n";
+        std::cerr << "strata integrate: sweeps of " << r->points_topic()
+                  << (r->posed() ? " posed in " : " in ") << r->fixed_frame() << ", "
+                  << r->deskew_note() << "\n";
     }
     if (args.odometry) {
-        std::cerr << "strata integrate: poses by LiDAR odometry, in the first scan's frame\n";
+        std::cerr << "strata integrate: poses by LiDAR odometry, in the first scan's frame turned "
+                     "level\n";
     }
 }
 
@@ -139,6 +141,7 @@ void RegisterIntegrate(CLI::App& app) {
         "  strata integrate city.strata --kitti day2/ --align --init 3,-1,0,10\n"
         "  strata integrate street.strata --bag drive.bag --points-topic /points_raw\n"
         "  strata integrate street.strata --kitti drive/ --odometry --poses-out poses.txt\n"
+        "  strata integrate street.strata --bag drive.mcap --odometry --poses-out poses.tum\n"
         "Each run adds one session; the map changes only once every scan is integrated.");
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     AddScanOptions(*cmd, args->scans);

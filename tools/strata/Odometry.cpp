@@ -30,17 +30,16 @@ void Run(OdometryArgs args) {
                                                       args.threads);
     }
     args.scans.require_poses = false;  // the odometry estimates them
-    if (!args.scans.bag.empty()) {
-        throw InvalidArgumentError(
-            "strata odometry reads --kitti or --scans; a recording's sweeps are posed by its tf "
-            "tree (strata integrate --bag), odometry for recordings is not built yet");
-    }
     pipeline::OdometryOptions options;
     options.skip_failures = args.on_failure == "skip";
     options.progress = ProgressBars();
     pipeline::RequireTrajectoryFile(args.poses_out);  // before any scan is read
     const pipeline::ScanSource source =
         pipeline::ScanSource::Open(args.scans, Eigen::Vector3d::Zero());
+    if (const recordings::RecordedScans* r = source.recording()) {
+        std::cerr << "strata odometry: sweeps of " << r->points_topic() << " in "
+                  << r->fixed_frame() << ", " << r->deskew_note() << "\n";
+    }
     const pipeline::EstimatedTrajectory t = pipeline::EstimateTrajectory(source, options);
     for (const std::string& line : pipeline::OdometryWarnings(t)) {
         std::cerr << "strata odometry: " << line << "\n";
@@ -63,15 +62,20 @@ void RegisterOdometry(CLI::App& app) {
         "Examples:\n"
         "  strata odometry --kitti drive/ --poses-out drive_poses.txt\n"
         "  strata odometry --scans scans/*.pcd --poses-out poses.tum --odometry-on-failure skip\n"
-        "The first scan defines the frame; .txt is written as KITTI 3x4 rows (the sensor in that\n"
-        "frame), .tum as TUM. A scan that cannot be registered stops the run and nothing is\n"
+        "  strata odometry --bag drive.bag --points-topic /points_raw --poses-out poses.tum\n"
+        "The first scan, turned level, defines the frame; .txt is written as KITTI 3x4 rows (the\n"
+        "sensor in that frame), .tum as TUM. A recording's /tf is not read; its sweeps with\n"
+        "per-point times are deskewed by the estimated motion (--no-deskew: not). A scan that "
+        "cannot be registered stops the run and nothing is\n"
         "written, unless --odometry-on-failure skip (docs/odometry.md).");
     cmd->add_option("--kitti", args->scans.kitti,
                     "KITTI-layout sequence folder (poses.txt not needed, ignored when present)");
+    AddRecordingOptions(*cmd, args->scans);
     cmd->add_option("--scans", args->scans.files,
                     "PCD, PLY, LAS, .bin or text files (.bz2 allowed), in driving order");
     AddBinFieldsOption(*cmd, args->scans.bin_fields);
-    cmd->add_option("--frames", args->scans.frames, "Frame range A:B of the sequence (half-open)");
+    cmd->add_option("--frames", args->scans.frames,
+                    "Frame range A:B of the sequence, or of the recording's sweeps (half-open)");
     cmd->add_option("--poses-out", args->poses_out, "Trajectory file: .txt (KITTI) or .tum (TUM)")
         ->required();
     cmd->add_option("--odometry-on-failure", args->on_failure,

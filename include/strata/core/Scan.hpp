@@ -20,13 +20,16 @@ struct RayOrigin {
 
 /// @brief One LiDAR sweep: points in the sensor frame, optional per-point data, and the sensor
 /// pose.
-/// @note `labels` and `intensity` are either empty or exactly `points.size()` long (Validate
-/// checks).
+/// @note `labels`, `instances`, `intensity` and `times_s` are either empty or exactly
+/// `points.size()` long (Validate checks).
 struct Scan {
     std::vector<Eigen::Vector3d> points;  ///< sensor frame, metres
     std::vector<SemanticClass> labels;    ///< optional, already mapped to strata's classes
     std::vector<uint16_t> instances;      ///< optional instance ids (SemanticKITTI upper 16 bits)
     std::vector<float> intensity;         ///< optional, as the source stores it
+    /// Optional: when each point was measured, seconds after `time_s` (the instant of
+    /// `T_world_sensor`), for a sweep not yet deskewed (recordings::Deskew empties it).
+    std::vector<float> times_s;
     Eigen::Isometry3d T_world_sensor = Eigen::Isometry3d::Identity();
     /// Optional: empty when every ray starts at the sensor's origin (0, 0, 0); else the first
     /// run begins at point 0 and the runs' `begin`s increase.
@@ -39,5 +42,11 @@ struct Scan {
     /// the ray origins are out of order or not finite, or the pose is not finite.
     void Validate() const;
 };
+
+/// @brief The pose a fraction `alpha` of the way from `a` to `b`: the translation on the line
+/// through both, the rotation turned about their relative axis at a constant rate (slerp).
+/// `alpha` outside [0, 1] extrapolates the same motion.
+[[nodiscard]] Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
+                                            double alpha);
 
 }  // namespace strata::core

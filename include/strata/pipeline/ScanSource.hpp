@@ -28,8 +28,9 @@ struct ScanSpec {
     std::vector<std::filesystem::path> files;  ///< PCD, PLY, LAS, .bin or text (.bz2)
     std::filesystem::path poses;               ///< KITTI 3x4 or TUM, by index; empty: identity
     int bin_fields = 0;  ///< float32 values per point of raw .bin files; 0: from name or size
-    /// False: a KITTI folder without poses.txt opens with identity poses (the odometry
-    /// estimates them).
+    /// False: the odometry estimates the poses; a KITTI folder without poses.txt opens with
+    /// identity poses, a recording's sweeps are read unposed with their points' times
+    /// (recordings::RecordedScanOptions::posed).
     bool require_poses = true;
 
     /// @brief Throws InvalidArgumentError unless exactly one of `kitti`, `files` and `bag` is
@@ -56,12 +57,16 @@ public:
                                           const io::ReadOptions& options);
 
     /// @brief Scans `scans` of this source (its indices), in that order, at `poses` instead of
-    /// their own: poses an odometry estimated.
-    /// @throw InvalidArgumentError for a recording's sweeps, or sizes that differ.
+    /// their own: poses an odometry estimated for instants `times_s`. A scan with its points'
+    /// times (a recording's sweep read unposed) is deskewed by that trajectory, interpolated
+    /// between its poses (extrapolated past its ends).
+    /// @throw InvalidArgumentError for a recording's sweeps posed by its tf tree, or sizes that
+    /// differ.
     [[nodiscard]] ScanSource Posed(const std::vector<size_t>& scans,
-                                   std::vector<Eigen::Isometry3d> poses) const;
+                                   std::vector<Eigen::Isometry3d> poses,
+                                   std::vector<double> times_s) const;
 
-    [[nodiscard]] size_t size() const { return recording_ ? recording_->size() : indices_.size(); }
+    [[nodiscard]] size_t size() const { return indices_.size(); }
     /// @brief Scan `i` (0 <= i < size()) with its pose; reader errors name the file.
     [[nodiscard]] core::Scan Read(size_t i) const;
     /// @brief The sequence folder, the first file, or the recording and its topic.
@@ -73,10 +78,11 @@ public:
 private:
     std::optional<io::KittiSequence> kitti_;
     std::shared_ptr<const recordings::RecordedScans> recording_;
-    std::vector<size_t> indices_;  // into the sequence, or into files_
+    std::vector<size_t> indices_;  // into the sequence, the recording's sweeps, or files_
     std::vector<std::filesystem::path> files_;
     std::vector<Eigen::Isometry3d> poses_;  // the pose file's, by file
     std::vector<Eigen::Isometry3d> posed_;  // Posed's, by index i of Read(i)
+    std::vector<double> posed_times_s_;     // and their instants
     io::ReadOptions options_;
 };
 

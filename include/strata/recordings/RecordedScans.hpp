@@ -27,13 +27,18 @@ struct RecordedScanOptions {
     /// order.
     std::string frames;
     bool deskew = true;  ///< where the clouds have per-point times and the poses are dense enough
+    /// False: the sweeps are not posed by the recording (no trajectory needed, /tf and the
+    /// odometry topic are not read): each comes at the identity in its own frame, not deskewed,
+    /// with its points' times (core::Scan::times_s, unless not `deskew`) for whoever estimates
+    /// the motion.
+    bool posed = true;
 };
 
 /// @brief The sweeps, indexed by stamp; each is read and posed when asked for.
 class RecordedScans {
 public:
     /// @brief Reads the recording's transforms and the clouds' stamps and frames (not their
-    /// points), and checks that every chosen sweep can be posed.
+    /// points), and checks that every chosen sweep can be posed (when `posed`).
     /// @throw NotFoundError for a missing topic or frame; InvalidArgumentError when the points
     /// topic must be named (the refusal lists the candidates) or the frame range is bad;
     /// RefusedError naming the sweep, its stamp and the trajectory's span when a sweep lies
@@ -44,7 +49,8 @@ public:
     [[nodiscard]] size_t size() const { return sweeps_.size(); }
 
     /// @brief Sweep `i` in the sensor's frame at its stamp, posed there (`T_world_sensor` is the
-    /// sensor in the fixed frame). Deskewed: each point moved by the pose of its own instant into
+    /// sensor in the fixed frame; the identity when not `posed`), with its points' times
+    /// (`times_s`) when not posed. Deskewed: each point moved by the pose of its own instant into
     /// the frame of the stamp's, and the points ordered into runs whose rays start where the
     /// sensor was during the run (`ray_origins`, within 2.5 cm of the true origin).
     /// @throw RefusedError when a point's time lies outside the trajectory; FormatError for a
@@ -56,6 +62,7 @@ public:
     [[nodiscard]] const std::string& fixed_frame() const { return fixed_frame_; }
     [[nodiscard]] const TransformTree& tree() const { return tree_; }
     [[nodiscard]] bool deskewing() const { return deskew_; }
+    [[nodiscard]] bool posed() const { return posed_; }
     /// @brief Why the sweeps are or are not deskewed, for the program to say.
     [[nodiscard]] const std::string& deskew_note() const { return deskew_note_; }
 
@@ -74,6 +81,8 @@ private:
     size_t first_ = 0;           // the first chosen sweep's index among all, for messages
     std::string points_topic_, fixed_frame_, deskew_note_;
     bool deskew_ = false;
+    bool posed_ = true;
+    bool times_ = false;  // an unposed sweep's points' times are kept for the odometry
 };
 
 }  // namespace strata::recordings

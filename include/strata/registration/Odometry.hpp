@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "strata/core/Scan.hpp"
 #include "strata/registration/Gravity.hpp"
 
 namespace strata::registration {
@@ -65,7 +66,7 @@ struct OdometryStep {
     size_t correspondences = 0;  ///< of those, matched at the end
     double rmse_m = 0.0;         ///< of the matched residuals
     double threshold_m = 0.0;    ///< the correspondence distance used
-    int iterations = 0;
+    int iterations = 0;  ///< Gauss-Newton iterations (both passes of a sweep deskewed twice)
     /// The smallest eigenvalue of the last step's normal equations per unit of match weight
     /// (rotations scaled to metres at the points' distance): near zero along a direction the
     /// geometry does not constrain, which then keeps the prediction.
@@ -89,10 +90,15 @@ public:
     Odometry(Odometry&&) noexcept;
     Odometry& operator=(Odometry&&) noexcept;
 
-    /// @brief Registers the next scan (points in the sensor frame, metres). A registered scan
-    /// joins the map and the motion model; a refused one changes neither (the caller skips it or
-    /// stops). Never throws for a scan it cannot register.
+    /// @brief Registers the next scan (points in the sensor frame, metres), the scans taken at a
+    /// steady rate. A registered scan joins the map and the motion model; a refused one changes
+    /// neither (the caller skips it or stops). Never throws for a scan it cannot register.
     OdometryStep Register(const std::vector<Eigen::Vector3d>& points);
+    /// @brief The same for a scan taken at `scan.time_s`: the prediction runs at the velocity of
+    /// the last two poses over their instants, and a sweep with its points' times
+    /// (`scan.times_s`) is deskewed by that velocity before it is registered and joins the map.
+    /// The pose found is the sensor's at `scan.time_s`.
+    OdometryStep Register(const core::Scan& scan);
     /// @brief The same from `guess` instead of the motion model's prediction (a session's first
     /// scan placed in an existing map, say).
     OdometryStep Register(const std::vector<Eigen::Vector3d>& points,
