@@ -1,5 +1,6 @@
 #include "strata/core/Scan.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "strata/core/Error.hpp"
@@ -47,6 +48,17 @@ Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3
     T.linear() =
         a.linear() * Eigen::AngleAxisd(alpha * turn.angle(), turn.axis()).toRotationMatrix();
     return T;
+}
+
+Eigen::Isometry3d PoseAt(const std::vector<double>& times_s,
+                         const std::vector<Eigen::Isometry3d>& poses, double t) {
+    if (poses.size() == 1) return poses.front();
+    const auto after = std::upper_bound(times_s.begin(), times_s.end(), t);
+    const size_t b =
+        std::clamp<size_t>(static_cast<size_t>(after - times_s.begin()), 1, times_s.size() - 1);
+    const double dt = times_s[b] - times_s[b - 1];
+    const double alpha = dt > 0.0 ? (t - times_s[b - 1]) / dt : 0.0;
+    return Interpolate(poses[b - 1], poses[b], alpha);
 }
 
 }  // namespace strata::core

@@ -43,6 +43,17 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
         ReportProgress(options.progress, "odometry", i + 1, source.size());
     }
     if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
+    if (const recordings::RecordedScans* recording = source.recording()) {
+        const recordings::ImuReadings& imu = recording->imu();
+        out.imu_note = imu.note;
+        if (!imu.topic.empty()) {
+            out.imu = registration::LevelFromAccelerometer({imu.times_s, imu.specific_force},
+                                                           out.times_s, out.poses);
+            if (out.imu->found) {
+                for (Eigen::Isometry3d& T : out.poses) T = out.imu->R_level * T;
+            }
+        }
+    }
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
 }
@@ -64,21 +75,34 @@ std::vector<std::string> OdometryWarnings(const EstimatedTrajectory& t) {
 }
 
 std::string DescribeGravity(const EstimatedTrajectory& t) {
-    if (!t.ground) return "gravity: the first scan's z (levelling was off)";
+    char text[400];
+    if (t.imu && t.imu->found) {
+        const registration::ImuLevel& i = *t.imu;
+        std::snprintf(text, sizeof(text),
+                      "gravity: the IMU's accelerometer (%s; %zu readings over %.1f s against "
+                      "the poses, RMS %.3f m; g %.3f m/s^2): the first scan was tilted %.2f "
+                      "deg%s",
+                      t.imu_note.c_str(), i.readings, i.span_s, i.residual_m, i.g, i.first_tilt_deg,
+                      t.ground && t.ground->found ? "" : " (no ground plane in the first scan)");
+        return text;
+    }
+    const std::string imu = t.imu ? "the IMU's readings were not used (" + t.imu->failure + "); "
+                            : !t.imu_note.empty() ? "no IMU (" + t.imu_note + "); "
+                                                  : "";
+    if (!t.ground) return "gravity: " + imu + "the first scan's z (levelling was off)";
     const registration::GroundLevel& g = *t.ground;
-    char text[240];
     if (!g.found) {
         std::snprintf(text, sizeof(text),
-                      "gravity: no ground plane in the first scan (%s): the map's z is the first "
-                      "scan's",
+                      "no ground plane in the first scan (%s): the map's z is the first scan's",
                       g.failure.c_str());
     } else {
         std::snprintf(text, sizeof(text),
-                      "gravity: the first scan's ground plane (no IMU read): the scan was tilted "
-                      "%.2f deg, %zu returns on the plane, RMS %.3f m, sensor %.2f m above it",
-                      g.tilt_deg, g.points, g.rms_m, g.height_m);
+                      "the first scan's ground plane%s: the scan was tilted %.2f deg, %zu returns "
+                      "on the plane, RMS %.3f m, sensor %.2f m above it",
+                      imu.empty() ? " (no IMU read)" : "", g.tilt_deg, g.points, g.rms_m,
+                      g.height_m);
     }
-    return text;
+    return "gravity: " + imu + text;
 }
 
 void RequireTrajectoryFile(const std::filesystem::path& out) {

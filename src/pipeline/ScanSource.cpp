@@ -1,7 +1,5 @@
 #include "strata/pipeline/ScanSource.hpp"
 
-#include <algorithm>
-
 #include "strata/core/Error.hpp"
 #include "strata/core/FrameRange.hpp"
 #include "strata/io/PoseFiles.hpp"
@@ -10,23 +8,6 @@
 namespace strata::pipeline {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-// The trajectory's pose at `t`, interpolated between the poses around it (extrapolated from the
-// first or last two).
-Eigen::Isometry3d PoseAt(const std::vector<double>& times,
-                         const std::vector<Eigen::Isometry3d>& poses, double t) {
-    if (poses.size() == 1) return poses.front();
-    const auto after = std::upper_bound(times.begin(), times.end(), t);
-    const size_t b =
-        std::clamp<size_t>(static_cast<size_t>(after - times.begin()), 1, times.size() - 1);
-    const double dt = times[b] - times[b - 1];
-    const double alpha = dt > 0.0 ? (t - times[b - 1]) / dt : 0.0;
-    return core::Interpolate(poses[b - 1], poses[b], alpha);
-}
-
-}  // namespace
 
 void ScanSpec::Validate() const {
     if (int{!kitti.empty()} + int{!files.empty()} + int{!bag.empty()} != 1) {
@@ -117,7 +98,8 @@ core::Scan ScanSource::Read(size_t i) const {
     scan.T_world_sensor = posed_.at(i);
     const Eigen::Isometry3d T_stamp_world = scan.T_world_sensor.inverse();
     recordings::Deskew(scan, [&](double tau) {
-        return Eigen::Isometry3d(T_stamp_world * PoseAt(posed_times_s_, posed_, scan.time_s + tau));
+        return Eigen::Isometry3d(T_stamp_world *
+                                 core::PoseAt(posed_times_s_, posed_, scan.time_s + tau));
     });
     return scan;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "strata/core/Error.hpp"
 #include "strata/core/FrameRange.hpp"
@@ -50,6 +51,38 @@ std::string ChoosePointsTopic(const RecordingInfo& info, const std::string& want
     return clouds.front();
 }
 
+// The IMU topic whose readings go to the odometry: the one named, else the recording's one Imu
+// topic; empty (and `note` says why) when there is none to read.
+std::string ChooseImuTopic(const RecordingInfo& info, const RecordedScanOptions& options,
+                           std::string* note) {
+    const std::string type = "sensor_msgs/Imu";
+    if (!options.imu_topic.empty()) {
+        const Topic* t = info.Find(options.imu_topic);
+        if (t == nullptr) {
+            throw NotFoundError(info.path.string() + ": no topic " + options.imu_topic +
+                                " (its Imu topics: " + TopicList(info, type) + ")");
+        }
+        if (!IsType(*t, type)) {
+            throw InvalidArgumentError(info.path.string() + ": topic " + options.imu_topic +
+                                       " holds " + t->type + ", not " + type);
+        }
+        return options.imu_topic;
+    }
+    if (!options.imu) {
+        *note = "not read (--no-imu)";
+        return "";
+    }
+    std::vector<std::string> imus;
+    for (const Topic& t : info.topics) {
+        if (IsType(t, type)) imus.push_back(t.name);
+    }
+    if (imus.size() == 1) return imus.front();
+    *note = imus.empty() ? "the recording has no sensor_msgs/Imu topic"
+                         : std::to_string(imus.size()) + " Imu topics (" + TopicList(info, type) +
+                               "): choose one with --imu-topic";
+    return "";
+}
+
 }  // namespace
 
 RecordedScans RecordedScans::Open(const std::filesystem::path& path,
@@ -78,10 +111,18 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
     } else if (s.posed_ && info.Find(kTf) != nullptr) {
         topics.emplace_back(kTf);
     }
+    std::string imu_topic;
+    if (!s.posed_) {
+        imu_topic = ChooseImuTopic(info, options, &s.imu_.note);
+        if (!imu_topic.empty()) topics.push_back(imu_topic);
+    }
+    std::vector<Imu> imu;
     std::string odom_frame;
     s.recording_->Read(topics, [&](const Message& m) {
         const std::string& topic = m.topic->name;
-        if (topic == s.points_topic_) {
+        if (topic == imu_topic) {
+            imu.push_back(DecodeImu(m, file));
+        } else if (topic == s.points_topic_) {
             Header h = DecodeHeader(m, file);
             s.sweeps_.push_back({h.stamp_ns, std::move(h.frame_id), m.location});
         } else if (topic == kTf || topic == kTfStatic) {
@@ -118,6 +159,7 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
                                            ": one sensor's sweeps are needed");
             }
         }
+        s.ReadImu(imu_topic, imu);
         s.times_ = options.deskew;
         s.deskew_note_ = options.deskew
                              ? "not posed by the recording: the odometry deskews the sweeps that "
@@ -193,6 +235,39 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
                      kFieldNames[static_cast<int>(field)] + "' (" + std::to_string(poses) +
                      " poses for " + std::to_string(s.sweeps_.size()) + " sweeps)";
     return s;
+}
+
+void RecordedScans::ReadImu(const std::string& topic, const std::vector<Imu>& readings) {
+    if (topic.empty()) return;
+    if (readings.empty()) {
+        imu_.note = topic + " holds no message";
+        return;
+    }
+    // The IMU's mounting on the sensor: the same frame, or fixed transforms between them.
+    const std::string& frame = readings.front().header.frame_id;
+    Eigen::Matrix3d R_sensor_imu = Eigen::Matrix3d::Identity();
+    if (frame != fixed_frame_) {
+        try {
+            R_sensor_imu =
+                tree_.Lookup(fixed_frame_, frame, readings.front().header.stamp_ns).linear();
+        } catch (const Error& e) {
+            imu_.note = topic + " is in frame " + frame +
+                        ", which /tf_static does not connect to " + fixed_frame_ + " (" + e.what() +
+                        "): not used";
+            return;
+        }
+    }
+    imu_.topic = topic;
+    for (const Imu& r : readings) {
+        imu_.times_s.push_back(static_cast<double>(r.header.stamp_ns) * 1e-9);
+        imu_.specific_force.push_back(R_sensor_imu * r.linear_acceleration);
+        imu_.angular_velocity.push_back(R_sensor_imu * r.angular_velocity);
+    }
+    const double span = imu_.times_s.back() - imu_.times_s.front();
+    char text[160];
+    std::snprintf(text, sizeof(text), ": %zu readings at %.0f Hz in frame ", readings.size(),
+                  span > 0.0 ? static_cast<double>(readings.size() - 1) / span : 0.0);
+    imu_.note = topic + text + frame;
 }
 
 std::string RecordedScans::Name(size_t i) const {

@@ -32,11 +32,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             });
         });
     });
-    fuzz::Refusal([&] {
-        const RecordedScans scans = RecordedScans::Open(path, {});
-        for (size_t i = 0; i < scans.size(); ++i) {
-            fuzz::Refusal([&] { fuzz::ExpectValidScan(scans.Read(i), true); });
-        }
-    });
+    // Posed by the tf tree and deskewed; and unposed for the odometry, with its IMU's readings.
+    RecordedScanOptions unposed;
+    unposed.posed = false;
+    for (const RecordedScanOptions& options : {RecordedScanOptions{}, unposed}) {
+        fuzz::Refusal([&] {
+            const RecordedScans scans = RecordedScans::Open(path, options);
+            for (size_t i = 0; i < scans.size(); ++i) {
+                fuzz::Refusal([&] { fuzz::ExpectValidScan(scans.Read(i), true); });
+            }
+        });
+    }
     return 0;
 }

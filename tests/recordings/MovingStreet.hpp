@@ -18,11 +18,20 @@
 namespace strata::recordings::test {
 
 struct MovingSweeps {
+    fs::path dir;  // the KITTI-layout folder the bag was written from
     fs::path bag;
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();     // in the poses' frame (the session's)
     std::vector<Eigen::Isometry3d> starts;             // per sweep, the sensor at its stamp
     std::vector<std::vector<Eigen::Vector3d>> truth;   // per sweep, world points as simulated
     std::vector<std::vector<Eigen::Vector3d>> origin;  // per sweep, each point's ray origin
 };
+
+/// Another bag of `sweeps`' folder, written with `options` besides `--motion`.
+inline fs::path WriteMovingBag(const MovingSweeps& sweeps, const std::string& name,
+                               const std::string& options) {
+    return WriteRos1Bag(sweeps.dir, name,
+                        options + " --motion " + (sweeps.dir / "end_poses.txt").string());
+}
 
 /// The first `max_scans` sweeps of datasets/scenes/street.json's drive at 10 m/s, a sweep every
 /// `every` revolutions (the scene file's 3: 3 m apart; 1: the sensor's every sweep) seen by
@@ -52,6 +61,7 @@ inline MovingSweeps WriteMovingStreet(const std::string& sensor, int max_scans, 
         const Eigen::Isometry3d start = session.T_session_sensor(k);
         const Eigen::Isometry3d session_world = start * session.poses()[k].T_world_sensor.inverse();
         const Eigen::Isometry3d end = session_world * session.poses()[k].T_world_sensor_end;
+        out.up = session_world.linear().col(2);  // the simulator's world has z up
         out.starts.push_back(start);
         ends.push_back(end);
         times << session.poses()[k].time_s << "\n";
@@ -80,7 +90,8 @@ inline MovingSweeps WriteMovingStreet(const std::string& sensor, int max_scans, 
     io::WriteKittiPoses(dir / "poses.txt", out.starts);
     io::WriteKittiPoses(dir / "end_poses.txt", ends);
     times.close();
-    out.bag = WriteRos1Bag(dir, name, options + " --motion " + (dir / "end_poses.txt").string());
+    out.dir = dir;
+    out.bag = WriteMovingBag(out, name, options);
     return out;
 }
 

@@ -119,7 +119,10 @@ TEST(BagOdometry, StrataOdometryPosesTheRecordingAsItWasDriven) {
     const auto r = Strata("odometry --bag " + drive.bag.string() + " --poses-out " + out.string());
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_NE(r.out.find("the odometry deskews"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("gravity: the first scan's ground plane"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("gravity: no IMU (the recording has no sensor_msgs/Imu topic); the first "
+                         "scan's ground plane"),
+              std::string::npos)
+        << r.out;
     const std::vector<Eigen::Isometry3d> estimate = Poses(out);
     ASSERT_EQ(estimate.size(), drive.starts.size());
     const double ate = registration::AbsoluteTrajectoryRmse(estimate, drive.starts);
@@ -129,6 +132,51 @@ TEST(BagOdometry, StrataOdometryPosesTheRecordingAsItWasDriven) {
     EXPECT_TRUE(FailedWith(Strata("integrate " + tools::test::Temp("bag_unposed.strata").string() +
                                   " --bag " + drive.bag.string()),
                            tools::test::kNotFound, "--odometry"));
+}
+
+// The street climbs 1 % along the drive: its ground plane is 0.57 degrees off level, and so is a
+// map levelled by it. With the recording's IMU (python3-rosbag writes 100 Hz readings of an IMU
+// mounted upside down and turned 90 degrees, their noise 0.05 m/s^2), the accelerometer says
+// where up is. Measured on 2026-12-05: the first sweep's up 0.126 deg from the truth's with the
+// IMU, 0.572 deg from its ground plane (--no-imu). The 0.05 deg is missed on this drive
+// of 6 s: the odometry's poses lag by up to 0.3 m over its last six sweeps, which tilts the
+// gravity fitted to them by about that over the squared duration (ImuGravity.* holds the
+// estimator at 0.01 deg on true poses). Held at about 2.5x, and the ground plane at least
+// 0.4 deg off (the slope is what the IMU corrects).
+constexpr double kMaxImuLevelDeg = 0.3;
+constexpr double kMinGroundLevelDeg = 0.4;
+
+TEST(BagOdometry, TheRecordingsImuLevelsTheMapOfASlopingStreet) {
+    const MovingSweeps& drive = Drive();
+    char up[96];
+    std::snprintf(up, sizeof(up), "%.9f,%.9f,%.9f", drive.up.x(), drive.up.y(), drive.up.z());
+    const fs::path bag = WriteMovingBag(drive, "odometry_street_imu",
+                                        std::string("--point-time t --tf-from 1000 --imu ") + up);
+    // Degrees between the first sweep's up in the estimated world and in the true one.
+    const auto level = [&](const std::string& options) {
+        const fs::path out = tools::test::Temp("bag_imu_poses.txt");
+        const auto r = Strata("odometry --bag " + bag.string() + " --poses-out " + out.string() +
+                              " " + options);
+        EXPECT_EQ(r.code, 0) << r.out;
+        const Eigen::Vector3d estimated =
+            Poses(out).front().linear().transpose() * Eigen::Vector3d::UnitZ();
+        const Eigen::Vector3d truth = drive.starts.front().linear().transpose() * drive.up;
+        return std::make_pair(
+            std::atan2(estimated.cross(truth).norm(), estimated.dot(truth)) * 180.0 / M_PI, r.out);
+    };
+    const auto [imu, imu_out] = level("");
+    const auto [ground, ground_out] = level("--no-imu");
+    EXPECT_NE(imu_out.find("gravity: the IMU's accelerometer (/imu/data: "), std::string::npos)
+        << imu_out;
+    EXPECT_NE(ground_out.find("no IMU (not read (--no-imu)); the first scan's ground plane"),
+              std::string::npos)
+        << ground_out;
+    std::printf("the first sweep's up: %.4f deg off with the IMU, %.4f deg by the ground plane\n",
+                imu, ground);
+    ::testing::Test::RecordProperty("imu_level_deg", std::to_string(imu));
+    ::testing::Test::RecordProperty("ground_level_deg", std::to_string(ground));
+    EXPECT_LT(imu, kMaxImuLevelDeg);
+    EXPECT_GT(ground, kMinGroundLevelDeg);
 }
 
 // The share of the map's occupied voxels farther than one voxel from every true point (moved

@@ -5,7 +5,7 @@ writer of the recordings strata's tests read (tests/recordings/). Nothing of str
   write_ros1_bag.py SEQ OUT.bag [--compression none|bz2|lz4] [--frames A:B] [--chunk-kb N]
                     [--point-time none|t|time|timestamp|offset_time] [--float64] [--big-endian]
                     [--extra-cloud-topic] [--tf-rate K] [--tf-from K] [--odom] [--rename-x]
-                    [--motion END_POSES]
+                    [--motion END_POSES] [--imu UX,UY,UZ]
 
 SEQ holds velodyne/NNNNNN.bin (float32 x y z intensity), poses.txt (camera 0 in the world, 3x4
 per line) and calib.txt (Tr: velodyne to camera 0); the velodyne in the world is
@@ -21,6 +21,11 @@ recordings for the tests of refusals).
 velodyne/NNNNNN.time (float32 seconds after the stamp, per point) and END_POSES the sensor's pose
 one revolution (0.1 s) after the stamp (3x4 per line, as poses.txt); the stamps come from
 times.txt, and /tf gets K poses across each sweep from its start to its end pose.
+--imu UX,UY,UZ: an IMU on /imu/data (sensor_msgs/Imu, 100 Hz, frame imu_link mounted upside
+down and turned 90 degrees on base_link, on /tf_static) over the drive, up being (UX, UY, UZ) in
+the poses' world frame: the accelerometer reads g up (plus the vehicle's acceleration, taken
+from the poses) and the gyro the turn rate, each with seeded white noise (0.05 m/s^2,
+0.002 rad/s); no orientation (its covariance -1, as REP 145 says for an IMU without one).
 """
 import argparse
 import os
@@ -30,7 +35,7 @@ import rosbag
 import genpy
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import PointCloud2, PointField
+from sensor_msgs.msg import Imu, PointCloud2, PointField
 from std_msgs.msg import Header
 from tf2_msgs.msg import TFMessage
 
@@ -64,6 +69,56 @@ def quaternion(r):
     q[k] = (r[k, i] + r[i, k]) / s
     q[3] = (r[k, j] - r[j, k]) / s
     return tuple(q)
+
+
+# base_link -> imu_link: upside down (rolled 180 degrees) and yawed 90, 0.3 m ahead and 0.5 m up.
+IMU_MOUNT = np.array([[0.0, 1.0, 0.0, 0.3],
+                      [1.0, 0.0, 0.0, 0.0],
+                      [0.0, 0.0, -1.0, 0.5],
+                      [0.0, 0.0, 0.0, 1.0]])
+G = 9.80665  # m/s^2
+
+
+def rotation_vector(r):
+    """The axis times the angle of a rotation matrix (small and moderate angles)."""
+    angle = np.arccos(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0))
+    w = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    return w * (0.5 if angle < 1e-9 else angle / (2.0 * np.sin(angle)))
+
+
+def pose_at(knots, poses, t):
+    """The pose at time t, interpolated between the knots around it (held past the ends)."""
+    k = int(np.clip(np.searchsorted(knots, t) - 1, 0, len(knots) - 2))
+    a = float(np.clip((t - knots[k]) / (knots[k + 1] - knots[k]), 0.0, 1.0))
+    q = slerp(quaternion(poses[k][:3, :3]), quaternion(poses[k + 1][:3, :3]), a)
+    m = np.eye(4)
+    x, y, z, w = q
+    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    m[:3, 3] = (1 - a) * poses[k][:3, 3] + a * poses[k + 1][:3, 3]
+    return m
+
+
+def write_imu(bag, knots, poses, up):
+    """100 Hz readings of an IMU at IMU_MOUNT on base_link, which moves through `poses` at
+    times `knots` (seconds after T0)."""
+    rng = np.random.default_rng(20261205)
+    dt = 0.01
+    up = np.asarray(up, dtype=float) / np.linalg.norm(up)
+    for t in np.arange(knots[0], knots[-1], dt):
+        imu = [pose_at(knots, poses, t + d) @ IMU_MOUNT for d in (-dt, 0.0, dt)]
+        r = imu[1][:3, :3]
+        accel = (imu[2][:3, 3] - 2 * imu[1][:3, 3] + imu[0][:3, 3]) / (dt * dt)
+        f = r.T @ (G * up + accel) + rng.normal(0.0, 0.05, 3)
+        w = rotation_vector(r.T @ imu[2][:3, :3]) / dt + rng.normal(0.0, 0.002, 3)
+        msg = Imu()
+        stamp = genpy.Time(T0) + genpy.Duration.from_sec(t)
+        msg.header = Header(stamp=stamp, frame_id='imu_link')
+        msg.orientation_covariance[0] = -1.0
+        msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = w
+        msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = f
+        bag.write('/imu/data', msg, stamp)
 
 
 def slerp(q0, q1, a):
@@ -155,6 +210,7 @@ def main():
     ap.add_argument('--odom', action='store_true')
     ap.add_argument('--rename-x', action='store_true')
     ap.add_argument('--motion', default='')
+    ap.add_argument('--imu', default='')
     args = ap.parse_args()
 
     tr = np.eye(4)
@@ -184,8 +240,17 @@ def main():
     bag = rosbag.Bag(args.out, 'w', compression=args.compression,
                      chunk_threshold=args.chunk_kb * 1024)
     try:
-        bag.write('/tf_static', TFMessage([transform('base_link', 'velodyne', stamps[0], m=MOUNT)]),
-                  stamps[0])
+        mounts = [transform('base_link', 'velodyne', stamps[0], m=MOUNT)]
+        if args.imu:
+            mounts.append(transform('base_link', 'imu_link', stamps[0], m=IMU_MOUNT))
+        bag.write('/tf_static', TFMessage(mounts), stamps[0])
+        if args.imu:
+            knots = [(s - genpy.Time(T0)).to_sec() for s in stamps]
+            poses = list(base)
+            if ends is not None:  # the last sweep's end
+                knots.append(knots[-1] + 0.1)
+                poses.append(ends[-1])
+            write_imu(bag, knots, poses, [float(v) for v in args.imu.split(',')])
         for k, i in enumerate(frames):
             points = np.fromfile(os.path.join(args.seq, 'velodyne', bins[i]),
                                  dtype=np.float32).reshape(-1, 4)

@@ -21,6 +21,12 @@ void AddRecordingOptions(CLI::App& cmd, pipeline::ScanSpec& spec) {
         "--no-deskew", [&r](int64_t) { r.deskew = false; },
         "Do not deskew the recording's sweeps (by default each point is moved by the pose of its "
         "own time where the clouds carry per-point times)");
+    cmd.add_option("--imu-topic", r.imu_topic,
+                   "With --odometry: the sensor_msgs/Imu topic whose accelerometer says where up "
+                   "is (default: the recording's one Imu topic)");
+    cmd.add_flag(
+        "--no-imu", [&r](int64_t) { r.imu = false; },
+        "With --odometry: do not read the recording's IMU (up from the first scan's ground)");
 }
 
 void AddScanOptions(CLI::App& cmd, pipeline::ScanSpec& spec) {

@@ -49,4 +49,9 @@ struct Scan {
 [[nodiscard]] Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
                                             double alpha);
 
+/// @brief The pose of a trajectory (`poses` at increasing instants `times_s`, at least one) at
+/// instant `t`: interpolated between the two around it, extrapolated from the first or last two.
+[[nodiscard]] Eigen::Isometry3d PoseAt(const std::vector<double>& times_s,
+                                       const std::vector<Eigen::Isometry3d>& poses, double t);
+
 }  // namespace strata::core

@@ -10,6 +10,7 @@
 
 #include "strata/pipeline/Progress.hpp"
 #include "strata/pipeline/ScanSource.hpp"
+#include "strata/registration/ImuGravity.hpp"
 #include "strata/registration/Odometry.hpp"
 
 namespace strata::pipeline {
@@ -37,6 +38,10 @@ struct EstimatedTrajectory {
     /// What set the map's z: the first registered scan's ground plane (found or not; see
     /// registration::OdometryConfig::level_from_ground).
     std::optional<registration::GroundLevel> ground;
+    /// What the recording's IMU said about up, when one was read; found, the poses are turned
+    /// level by it (the ground plane's levelling undone).
+    std::optional<registration::ImuLevel> imu;
+    std::string imu_note;  ///< the recording's IMU: what was read, or why none was
 };
 
 /// @brief What the program warns of after a run, a line each: the scans left out, and how many
@@ -44,10 +49,12 @@ struct EstimatedTrajectory {
 [[nodiscard]] std::vector<std::string> OdometryWarnings(const EstimatedTrajectory& trajectory);
 
 /// @brief One line on where the map's up came from, for the program's output: "gravity: the
-/// first scan's ground plane, ..." or "gravity: none found (...): z is the first scan's".
+/// IMU's accelerometer ...", "gravity: the first scan's ground plane, ..." or "gravity: none
+/// found (...): z is the first scan's".
 [[nodiscard]] std::string DescribeGravity(const EstimatedTrajectory& trajectory);
 
-/// @brief Reads each scan of `source` and registers it.
+/// @brief Reads each scan of `source` and registers it; with a recording's IMU, turns the poses
+/// level by its accelerometer (registration::LevelFromAccelerometer).
 /// @throw RefusedError naming the scan and why ("scan 12 (<file>): too little overlap ...")
 /// when one cannot be registered and `skip_failures` is false, or when no scan was registered;
 /// the readers' errors; InvalidArgumentError for a bad config.

@@ -32,6 +32,22 @@ struct RecordedScanOptions {
     /// with its points' times (core::Scan::times_s, unless not `deskew`) for whoever estimates
     /// the motion.
     bool posed = true;
+    /// Unposed only: the sensor_msgs/Imu topic whose readings go to the odometry (empty: the
+    /// recording's one Imu topic, if it has exactly one), and whether to read one at all.
+    std::string imu_topic;
+    bool imu = true;
+};
+
+/// @brief An IMU's readings turned into the sweeps' frame by its mounting (/tf_static), for the
+/// odometry's gravity (docs/odometry.md, "Gravity").
+struct ImuReadings {
+    std::string topic;  ///< empty when none were read
+    std::vector<double> times_s;
+    std::vector<Eigen::Vector3d> specific_force;    ///< m/s^2, as the accelerometer measured
+    std::vector<Eigen::Vector3d> angular_velocity;  ///< rad/s
+    /// What was read ("/imu/data: 6000 readings at 100 Hz in frame imu_link") or why nothing
+    /// was ("no sensor_msgs/Imu topic", "--no-imu", "frame imu_link is not connected ...").
+    std::string note;
 };
 
 /// @brief The sweeps, indexed by stamp; each is read and posed when asked for.
@@ -40,7 +56,8 @@ public:
     /// @brief Reads the recording's transforms and the clouds' stamps and frames (not their
     /// points), and checks that every chosen sweep can be posed (when `posed`).
     /// @throw NotFoundError for a missing topic or frame; InvalidArgumentError when the points
-    /// topic must be named (the refusal lists the candidates) or the frame range is bad;
+    /// topic must be named (the refusal lists the candidates), a named IMU topic is not
+    /// sensor_msgs/Imu, or the frame range is bad;
     /// RefusedError naming the sweep, its stamp and the trajectory's span when a sweep lies
     /// outside it; the recording's FormatError for damage.
     [[nodiscard]] static RecordedScans Open(const std::filesystem::path& path,
@@ -63,6 +80,8 @@ public:
     [[nodiscard]] const TransformTree& tree() const { return tree_; }
     [[nodiscard]] bool deskewing() const { return deskew_; }
     [[nodiscard]] bool posed() const { return posed_; }
+    /// @brief The IMU's readings (unposed recordings only; see ImuReadings::note).
+    [[nodiscard]] const ImuReadings& imu() const { return imu_; }
     /// @brief Why the sweeps are or are not deskewed, for the program to say.
     [[nodiscard]] const std::string& deskew_note() const { return deskew_note_; }
 
@@ -74,12 +93,15 @@ private:
     };
 
     [[nodiscard]] std::string Name(size_t i) const;
+    // Keeps `readings` of `topic` turned into the sweeps' frame, or says why not (imu_.note).
+    void ReadImu(const std::string& topic, const std::vector<Imu>& readings);
 
     std::shared_ptr<const Recording> recording_;
     TransformTree tree_;
     std::vector<Sweep> sweeps_;  // the chosen ones, in stamp order
     size_t first_ = 0;           // the first chosen sweep's index among all, for messages
     std::string points_topic_, fixed_frame_, deskew_note_;
+    ImuReadings imu_;
     bool deskew_ = false;
     bool posed_ = true;
     bool times_ = false;  // an unposed sweep's points' times are kept for the odometry
