@@ -240,8 +240,8 @@ struct Odometry::State {
     detail::LocalMap map;
     std::vector<Eigen::Isometry3d> poses;
     std::vector<double> stamps;  // their instants, NaN when unknown
-    // The first scan as measured, kept while it is the map's only scan: once the second gives
-    // a velocity, the map restarts from it deskewed.
+    // The first scan as measured, kept while it is the map's only scan: once the second is
+    // registered and gives a velocity, the map restarts from it deskewed.
     struct {
         std::vector<Eigen::Vector3d> points;
         std::vector<float> times;
@@ -289,11 +289,16 @@ struct Odometry::State {
         error_squares += error * error;
         ++errors;
     }
-    void Keep(const std::vector<Eigen::Vector3d>& frame, const Eigen::Isometry3d& T, double t) {
+    // A thinned scan at pose T joins the map, which forgets what lies out of range.
+    void AddFrame(const std::vector<Eigen::Vector3d>& frame, const Eigen::Isometry3d& T) {
         std::vector<Eigen::Vector3d> world(frame.size());
         for (size_t i = 0; i < frame.size(); ++i) world[i] = T * frame[i];
         map.Add(world);
         map.RemoveFarFrom(T.translation(), config.max_range_m);
+    }
+    // And its pose and instant join the motion model.
+    void Keep(const std::vector<Eigen::Vector3d>& frame, const Eigen::Isometry3d& T, double t) {
+        AddFrame(frame, T);
         poses.push_back(T);
         stamps.push_back(t);
     }
@@ -414,25 +419,28 @@ OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& point
     }
     Eigen::Isometry3d T = Align(frame, step.T_world_sensor, &step);
     const double since = poses.empty() ? 0.0 : t - stamps.back();
+    // The map as it was while the first sweep's restart (below) waits on this scan's outcome: a
+    // refused scan changes nothing.
+    std::optional<detail::LocalMap> before;
+    const auto refuse = [&](const std::string& why) {
+        step.failure = why;
+        if (before) map = std::move(*before);
+        return step;
+    };
     if (timed && since > 0.0 && T.matrix().allFinite()) {
         const Eigen::Isometry3d found = poses.back().inverse() * T;
         if (!first_sweep.points.empty()) {
             // The map's first sweep, measured while moving too, deskewed at this velocity.
-            const Eigen::Isometry3d first = poses.back();
+            before = std::move(map);
             map = detail::LocalMap(c.voxel_m, c.max_points_per_voxel, c.max_planarity_ratio);
-            poses.pop_back();
-            stamps.pop_back();
-            Keep(Thinned(Deskewed(first_sweep.points, first_sweep.times, found, since)), first,
-                 t - since);
-            first_sweep = {};
+            AddFrame(Thinned(Deskewed(first_sweep.points, first_sweep.times, found, since)),
+                     poses.back());
         }
         frame = Thinned(Deskewed(points, *times, found, since));
         T = Align(frame, T, &step);
     }
-    if (!T.matrix().allFinite()) {
-        step.failure = "the registration diverged (a pose that is not finite)";
-        return step;
-    }
+    if (!T.matrix().allFinite())
+        return refuse("the registration diverged (a pose that is not finite)");
     const double overlap = step.points == 0 ? 0.0
                                             : static_cast<double>(step.correspondences) /
                                                   static_cast<double>(step.points);
@@ -444,9 +452,9 @@ OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& point
                       "(needs %d and %.0f %%)",
                       step.correspondences, step.points, step.threshold_m, c.min_correspondences,
                       100.0 * c.min_overlap);
-        step.failure = text;
-        return step;
+        return refuse(text);
     }
+    first_sweep = {};
     Learn(step.T_world_sensor, T);
     Keep(frame, T, t);
     step.T_world_sensor = T;
