@@ -21,18 +21,24 @@ std::string TopicList(const RecordingInfo& info, const std::string& type) {
     return names.empty() ? "none" : names;
 }
 
+// The named topic, which must exist and hold `type` ("sensor_msgs/Imu").
+void RequireTopic(const RecordingInfo& info, const std::string& name, const std::string& type) {
+    const Topic* t = info.Find(name);
+    if (t == nullptr) {
+        throw NotFoundError(info.path.string() + ": no topic " + name + " (its " +
+                            type.substr(type.find('/') + 1) + " topics: " + TopicList(info, type) +
+                            ")");
+    }
+    if (!IsType(*t, type)) {
+        throw InvalidArgumentError(info.path.string() + ": topic " + name + " holds " + t->type +
+                                   ", not " + type);
+    }
+}
+
 std::string ChoosePointsTopic(const RecordingInfo& info, const std::string& wanted) {
     const std::string type = "sensor_msgs/PointCloud2";
     if (!wanted.empty()) {
-        const Topic* t = info.Find(wanted);
-        if (t == nullptr) {
-            throw NotFoundError(info.path.string() + ": no topic " + wanted +
-                                " (its PointCloud2 topics: " + TopicList(info, type) + ")");
-        }
-        if (!IsType(*t, type)) {
-            throw InvalidArgumentError(info.path.string() + ": topic " + wanted + " holds " +
-                                       t->type + ", not " + type);
-        }
+        RequireTopic(info, wanted, type);
         return wanted;
     }
     std::vector<std::string> clouds;
@@ -57,15 +63,7 @@ std::string ChooseImuTopic(const RecordingInfo& info, const RecordedScanOptions&
                            std::string* note) {
     const std::string type = "sensor_msgs/Imu";
     if (!options.imu_topic.empty()) {
-        const Topic* t = info.Find(options.imu_topic);
-        if (t == nullptr) {
-            throw NotFoundError(info.path.string() + ": no topic " + options.imu_topic +
-                                " (its Imu topics: " + TopicList(info, type) + ")");
-        }
-        if (!IsType(*t, type)) {
-            throw InvalidArgumentError(info.path.string() + ": topic " + options.imu_topic +
-                                       " holds " + t->type + ", not " + type);
-        }
+        RequireTopic(info, options.imu_topic, type);
         return options.imu_topic;
     }
     if (!options.imu) {
@@ -97,16 +95,7 @@ RecordedScans RecordedScans::Open(const std::filesystem::path& path,
     if (info.Find(kTfStatic) != nullptr) topics.emplace_back(kTfStatic);
     s.posed_ = options.posed;  // else only the sweeps (and /tf_static, the sensor's mounting)
     if (s.posed_ && !options.odom_topic.empty()) {
-        const Topic* odom = info.Find(options.odom_topic);
-        if (odom == nullptr) {
-            throw NotFoundError(file + ": no topic " + options.odom_topic +
-                                " (its Odometry topics: " + TopicList(info, "nav_msgs/Odometry") +
-                                ")");
-        }
-        if (!IsType(*odom, "nav_msgs/Odometry")) {
-            throw InvalidArgumentError(file + ": topic " + options.odom_topic + " holds " +
-                                       odom->type + ", not nav_msgs/Odometry");
-        }
+        RequireTopic(info, options.odom_topic, "nav_msgs/Odometry");
         topics.push_back(options.odom_topic);
     } else if (s.posed_ && info.Find(kTf) != nullptr) {
         topics.emplace_back(kTf);
