@@ -12,8 +12,6 @@ namespace strata::registration {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // The points of a storey on horizontal surfaces: one per cell (the mean), normal within
 // `max_tilt_deg` of the vertical.
 std::vector<Eigen::Vector3d> HorizontalPoints(const std::vector<Eigen::Vector3d>& points,
@@ -23,7 +21,7 @@ std::vector<Eigen::Vector3d> HorizontalPoints(const std::vector<Eigen::Vector3d>
     const Surface s = Surface::FromPoints(points, surface);
     std::vector<Eigen::Vector3d> out;
     if (s.empty()) return out;
-    const double min_nz = std::cos(config.max_tilt_deg * kPi / 180.0);
+    const double min_nz = std::cos(config.max_tilt_deg * EIGEN_PI / 180.0);
     const SurfaceLevel& level = s.levels.back();
     for (size_t i = 0; i < level.points.size(); ++i) {
         if (std::abs(level.normals[i].z()) >= min_nz) out.push_back(level.points[i]);

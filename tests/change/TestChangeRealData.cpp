@@ -12,7 +12,7 @@
 #include "strata/io/KittiSequence.hpp"
 #include "strata/store/SessionWriter.hpp"
 
-namespace strata::change {
+namespace strata::change::real_data_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -151,4 +151,4 @@ TEST(ChangeRealData, BalmFirstHalfVersusSecondHalf) {
 }
 
 }  // namespace
-}  // namespace strata::change
+}  // namespace strata::change::real_data_tests

@@ -15,7 +15,7 @@
 #include "strata/sim/SimulateScene.hpp"
 #include "strata/store/SessionWriter.hpp"
 
-namespace strata::change {
+namespace strata::change::simulated_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -160,4 +160,4 @@ TEST(ChangeSimulated, NothingIsReportedWhereOneSessionNeverLooked) {
 }
 
 }  // namespace
-}  // namespace strata::change
+}  // namespace strata::change::simulated_tests

@@ -7,7 +7,7 @@
 
 #include "CostFunctions.hpp"
 
-namespace strata::registration::detail {
+namespace strata::registration::detail::cost_function_tests {
 namespace {
 
 constexpr double kSameResidual = 1e-12;
@@ -56,4 +56,4 @@ TEST(RegistrationCostFunctions, AnalyticJacobianMatchesAutomaticDifferentiation)
 }
 
 }  // namespace
-}  // namespace strata::registration::detail
+}  // namespace strata::registration::detail::cost_function_tests

@@ -17,7 +17,7 @@
 #include "strata/registration/SessionCloud.hpp"
 #include "strata/sim/SimulateScene.hpp"
 
-namespace strata::registration {
+namespace strata::registration::floors_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -284,4 +284,4 @@ TEST(RegistrationFloors, SliceAndConfigChecks) {
 }
 
 }  // namespace
-}  // namespace strata::registration
+}  // namespace strata::registration::floors_tests

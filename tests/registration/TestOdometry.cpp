@@ -20,7 +20,7 @@
 #include "strata/registration/TrajectoryError.hpp"
 #include "strata/walls/Walls.hpp"
 
-namespace strata::registration {
+namespace strata::registration::odometry_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -61,7 +61,7 @@ TEST(TrajectoryError, DriftOfAKnownScaleErrorAndATurn) {
 // (the heading turning up to 7 degrees a sweep in the middle of a turn), the sensor rolling and
 // pitching up to 1.5 and 0.9 degrees on the suspension. 1000 sweeps: a kilometre, six turns left
 // and right (the small district's serpentine of streets).
-constexpr test::DriveShape kCarDrive{15.0, 1.5};
+constexpr strata::test::DriveShape kCarDrive{15.0, 1.5};
 constexpr size_t kDriveSweeps = 1000;
 // Measured on 2026-12-05 (1000 sweeps, 999 m, turned through 630 degrees): t_rel 0.212 %, r_rel
 // 0.0635 deg / 100 m (lengths 50, 100, 200 m), ATE 0.300 m; the world's up (from the first
@@ -78,8 +78,8 @@ double DegreesBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 TEST(Odometry, DriftOverAKilometreOfTurnsWithPitchAndRoll) {
-    const test::SimulatedDrive& drive =
-        test::DistrictDrive(strata::testing::UnderSanitizer() ? 40 : kDriveSweeps, kCarDrive);
+    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(
+        strata::testing::UnderSanitizer() ? 40 : kDriveSweeps, kCarDrive);
     Odometry odometry;
     std::vector<Eigen::Isometry3d> estimate;
     double first_level = 0.0, worst_level = 0.0;
@@ -139,7 +139,7 @@ constexpr double kMaxMeanSlantDifferenceDeg = 0.35;
 constexpr double kMaxSlantDifferenceDeg = 1.2;
 
 TEST(Odometry, TheMapFromItsPosesLeansAsTheTrueMap) {
-    const test::SimulatedDrive& drive = test::DistrictDrive(kWallSweeps, kCarDrive);
+    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(kWallSweeps, kCarDrive);
     Odometry odometry;
     core::VoxelMap truth = core::VoxelMap::Create(kWallVoxelM);
     core::VoxelMap ours = core::VoxelMap::Create(kWallVoxelM);
@@ -229,14 +229,14 @@ constexpr double kMaxMovingTranslationPercent = 0.5;
 constexpr double kMaxMovingRotationDegPer100m = 0.2;
 constexpr double kMaxMovingAteM = 0.4;
 constexpr double kMinSkewedOverDeskewed = 2.0;
-constexpr test::DriveShape kCarDriveMoving{15.0, 1.5, true};
+constexpr strata::test::DriveShape kCarDriveMoving{15.0, 1.5, true};
 
 struct DriftFigures {
     Drift drift;
     double ate = 0.0;
 };
 
-DriftFigures OdometryDrift(const test::SimulatedDrive& drive, bool with_times) {
+DriftFigures OdometryDrift(const strata::test::SimulatedDrive& drive, bool with_times) {
     Odometry odometry;
     std::vector<Eigen::Isometry3d> estimate;
     for (size_t k = 0; k < drive.sweeps.size(); ++k) {
@@ -254,7 +254,7 @@ DriftFigures OdometryDrift(const test::SimulatedDrive& drive, bool with_times) {
 }
 
 TEST(Odometry, SweepsTakenWhileDrivingAreDeskewedByTheMotionModel) {
-    const test::SimulatedDrive& drive = test::DistrictDrive(
+    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(
         strata::testing::UnderSanitizer() ? 20 : kMotionSweeps, kCarDriveMoving);
     const DriftFigures deskewed = OdometryDrift(drive, true);
     const DriftFigures skewed = OdometryDrift(drive, false);
@@ -281,7 +281,7 @@ TEST(Odometry, SweepsTakenWhileDrivingAreDeskewedByTheMotionModel) {
 }
 
 TEST(Odometry, AScanFromElsewhereIsRefusedAndChangesNothing) {
-    const test::SimulatedDrive& drive = test::DistrictDrive(3, kCarDrive);
+    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(3, kCarDrive);
     Odometry odometry;
     ASSERT_TRUE(odometry.Register(drive.sweeps[0]).registered);
     ASSERT_TRUE(odometry.Register(drive.sweeps[1]).registered);
@@ -301,7 +301,7 @@ TEST(Odometry, AScanFromElsewhereIsRefusedAndChangesNothing) {
 // The same with sweeps measured while driving: the second sweep, the one whose velocity would
 // restart the map from the first sweep deskewed, refused, leaves the map as the first left it.
 TEST(Odometry, ARefusedSweepInMotionLeavesTheFirstSweepsMapAsItWas) {
-    const test::SimulatedDrive& drive = test::DistrictDrive(3, kCarDriveMoving);
+    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(3, kCarDriveMoving);
     const auto timed = [&](size_t k, const Eigen::Vector3d& shift) {
         core::Scan scan;
         for (const Eigen::Vector3d& p : drive.sweeps[k]) scan.points.push_back(p + shift);
@@ -361,4 +361,4 @@ TEST(OdometryRealData, Kitti00SixFramesAgreeWithTheStereoOdometries) {
 }
 
 }  // namespace
-}  // namespace strata::registration
+}  // namespace strata::registration::odometry_tests

@@ -11,7 +11,7 @@
 #include "RealPairs.hpp"
 #include "strata/io/PointCloudReaders.hpp"
 
-namespace strata::registration {
+namespace strata::registration::ouster_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -121,4 +121,4 @@ TEST(RegistrationRealDataOuster, TheTwoScansAreOfTwoPlacesAndRegistrationRefuses
 }
 
 }  // namespace
-}  // namespace strata::registration
+}  // namespace strata::registration::ouster_tests

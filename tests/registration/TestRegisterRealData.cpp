@@ -14,7 +14,7 @@
 #include "strata/io/KittiSequence.hpp"
 #include "strata/registration/SessionCloud.hpp"
 
-namespace strata::registration {
+namespace strata::registration::real_data_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -186,4 +186,4 @@ TEST(RegistrationRealData, BalmSecondSessionMovedByAKnownTransform) {
 }
 
 }  // namespace
-}  // namespace strata::registration
+}  // namespace strata::registration::real_data_tests

@@ -13,7 +13,7 @@
 #include "SyntheticGeometry.hpp"
 #include "strata/registration/SessionCloud.hpp"
 
-namespace strata::registration {
+namespace strata::registration::session_cloud_tests {
 namespace {
 
 using Cell = std::tuple<int, int, int>;
@@ -95,4 +95,4 @@ TEST(SessionCloud, PastItsLimitKeepsTheSameCellsWhateverTheOrderOfTheScans) {
 }
 
 }  // namespace
-}  // namespace strata::registration
+}  // namespace strata::registration::session_cloud_tests

@@ -9,7 +9,7 @@
 #include "strata/sim/SensorModel.hpp"
 #include "strata/sim/SimulateScene.hpp"
 
-namespace strata::sim {
+namespace strata::sim::simulate_scene_tests {
 namespace {
 
 // Coarse and short, so that the example scenes stay quick on a 2-core CI machine.
@@ -156,4 +156,4 @@ TEST(SimulateScene, DemoStreetIsSmallAndComplete) {
     EXPECT_NO_THROW(demo.Validate());
 }
 
-}  // namespace strata::sim
+}  // namespace strata::sim::simulate_scene_tests

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "MapDiff.hpp"
+#include "Sanitizer.hpp"
 #include "TempPath.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/store/MapStore.hpp"
@@ -26,6 +27,13 @@ using integration::IntegrationConfig;
 
 constexpr double kVoxel = 0.1;
 constexpr double kTile = 3.2;  // 32 voxels: a 12 m room spans many tiles
+
+/// The tile of the maps NewMap makes: kTile, or twice that under a sanitizer. Every grid of every
+/// tile allocates OpenVDB's 264 KB top node, which the sanitizers' allocators map and fault in
+/// afresh each time (docs/reliability.md, "Sanitizers"): the room over a quarter of the tiles
+/// halves the store tests' time there and still spans several. Tests that count tiles or cut
+/// regions at tile edges pass kTile.
+inline double TestTile() { return strata::testing::UnderSanitizer() ? 2 * kTile : kTile; }
 
 inline fs::path Temp(const std::string& name) { return strata::test::TempPath("store_" + name); }
 
@@ -69,10 +77,11 @@ inline SessionOptions Named(const std::string& name) {
     return options;
 }
 
-inline MapStore NewMap(const fs::path& dir, const IntegrationConfig& rule = {}) {
+inline MapStore NewMap(const fs::path& dir, const IntegrationConfig& rule = {},
+                       double tile_m = TestTile()) {
     StoreSettings settings;
     settings.voxel_size_m = kVoxel;
-    settings.tile_size_m = kTile;
+    settings.tile_size_m = tile_m;
     settings.integration = rule;
     return MapStore::Create(dir, settings);
 }

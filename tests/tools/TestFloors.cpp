@@ -10,7 +10,7 @@
 #include "CliTestUtil.hpp"
 #include "strata/store/MapStore.hpp"
 
-namespace strata::tools::test {
+namespace strata::tools::test::floors_cli_tests {
 namespace {
 
 using nlohmann::json;
@@ -194,4 +194,4 @@ TEST(RegistrationFloorsCli, RefusesUnknownFloorsAndSessions) {
 }
 
 }  // namespace
-}  // namespace strata::tools::test
+}  // namespace strata::tools::test::floors_cli_tests

@@ -29,6 +29,7 @@
 #include "strata/core/VoxelMap.hpp"
 #include "strata/store/MapStore.hpp"
 
+namespace store_faults_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -734,3 +735,4 @@ TEST(StoreFaults, UpgradeSaysWhatItDid) {
 }
 
 }  // namespace
+}  // namespace store_faults_tests

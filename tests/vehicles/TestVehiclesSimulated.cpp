@@ -10,7 +10,7 @@
 #include "ParkingEval.hpp"
 #include "TempPath.hpp"
 
-namespace strata::vehicles {
+namespace strata::vehicles::simulated_tests {
 namespace {
 
 namespace fs = std::filesystem;
@@ -87,4 +87,4 @@ TEST(VehiclesSimulated, ParkingGarageClearedAndRefilledBeatsClearingAlone) {
 }
 
 }  // namespace
-}  // namespace strata::vehicles
+}  // namespace strata::vehicles::simulated_tests
