@@ -16,6 +16,8 @@
 #   STRATA_SANITIZE_MIN_TESTS=N  fail when fewer than N tests are selected (.ci/run sets it;
 #          default: $tsan_min_tests for tsan without arguments, else 1). With no test selected
 #          ctest itself fails (--no-tests=error).
+#   STRATA_ASAN_CI_SELECTION=1  asan: do not build the test files that hold only tests CI's ASan
+#          run leaves out (tests/AsanSlowTests.txt; .ci/run sets it)
 #   STRATA_SANITIZE_BUILD_ONLY=1  build (and for tsan, libtbb) and stop: .ci/run builds both
 #          in the background while the normal build's tests run, then runs the tests here.
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
@@ -102,7 +104,12 @@ common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++
         -DSTRATA_BUILD_PYTHON=OFF)
 if [[ $mode == asan ]]; then
   build="$root/build-fuzz"
-  cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_BUILD_FUZZ=ON >/dev/null
+  # STRATA_ASAN_CI_SELECTION=1 (.ci/run): leave out the test files whose every test CI's ASan
+  # run leaves out (tests/AsanSlowTests.txt); unset, every test is built.
+  selection=OFF
+  [[ ${STRATA_ASAN_CI_SELECTION:-} == 1 ]] && selection=ON
+  cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_BUILD_FUZZ=ON \
+    -DSTRATA_ASAN_CI_SELECTION=$selection >/dev/null
   cmake --build "$build" -j "$jobs" ${STRATA_SANITIZE_TARGETS:+--target $STRATA_SANITIZE_TARGETS}
   filter=()
   export STRATA_SANITIZER=address

@@ -227,12 +227,15 @@ TEST(BagOdometry, IntegrateMapsTheRecordingDeskewedByTheEstimatedMotion) {
         return StrayShare(store.LoadMap(store.Latest()), drive, T_map_truth);
     };
     const double deskewed = map_of("bag_odometry_map", "");
+    EXPECT_LT(deskewed, kMaxDeskewedStray);
+    // Under a sanitizer the map as recorded is the same integration again with less to do (6 of
+    // the test's 36 s of ASan time): only the normal build shows what deskewing is worth.
+    if (strata::testing::UnderSanitizer()) return;
     const double skewed = map_of("bag_odometry_map_skewed", "--no-deskew");
     std::printf("bag odometry map: %.4f of the occupied voxels stray deskewed, %.4f as recorded\n",
                 deskewed, skewed);
     ::testing::Test::RecordProperty("deskewed_stray_share", std::to_string(deskewed));
     ::testing::Test::RecordProperty("skewed_stray_share", std::to_string(skewed));
-    EXPECT_LT(deskewed, kMaxDeskewedStray);
     EXPECT_GT(skewed, kMinSkewedStray);
 }
 
