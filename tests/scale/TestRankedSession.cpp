@@ -27,7 +27,7 @@ store::MapStore OpenShared(const fs::path& dir) {
     return OpenOnRanks(dir, TestRanks(), [&] {
         return store::MapStore::IsMap(dir)
                    ? store::MapStore::Open(dir, store::MapStore::Access::kWrite)
-                   : store::test::NewMap(dir, {}, store::test::kTile);
+                   : store::test::NewMapOfManyTiles(dir);
     });
 }
 
@@ -71,7 +71,7 @@ TEST(RankedSession, EveryRankCountGivesTheMapOneProcessGives) {
     if (!TestRanks().root()) return;
     // The reference: one process, one writer.
     store::MapStore reference =
-        store::test::NewMap(store::test::Temp("ranked_reference"), {}, store::test::kTile);
+        store::test::NewMapOfManyTiles(store::test::Temp("ranked_reference"));
     (void)store::test::Write(reference, first, store::test::Named("first"));
     (void)store::test::Write(reference, second, store::test::Named("second"));
     ExpectSameMap(map.LoadMap(map.Latest()), reference.LoadMap(reference.Latest()));

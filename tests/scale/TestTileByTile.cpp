@@ -28,8 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(TileByTile, InfoCountsEqualTheWholeMapsCounts) {
-    store::MapStore map =
-        store::test::NewMap(store::test::Temp("tiles_info"), {}, store::test::kTile);
+    store::MapStore map = store::test::NewMapOfManyTiles(store::test::Temp("tiles_info"));
     (void)store::test::Write(map, store::test::Session(1, {0.4, 0.2, 0.0}, 3));
     (void)store::test::Write(map, store::test::Session(9, {3.1, -1.7, 0.3}, 2));
     const nlohmann::json j = DescribeMap(map, "");
@@ -83,7 +82,7 @@ std::pair<std::string, std::vector<std::string>> PlyVertices(const fs::path& fil
 }
 
 store::MapStore TwoRooms(const std::string& name) {
-    store::MapStore map = store::test::NewMap(store::test::Temp(name), {}, store::test::kTile);
+    store::MapStore map = store::test::NewMapOfManyTiles(store::test::Temp(name));
     (void)store::test::Write(map, store::test::Session(1, {0.4, 0.2, 0.0}, 3));
     (void)store::test::Write(map, store::test::Session(9, {3.1, -1.7, 0.3}, 2));
     return map;

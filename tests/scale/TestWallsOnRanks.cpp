@@ -20,7 +20,7 @@ namespace {
 // tiles each hold walls of their own to judge, and a plane fitted to part of the floors' sample
 // is not the plane of all of it.
 store::MapStore NoisyRooms(const std::string& name) {
-    store::MapStore map = store::test::NewMap(store::test::Temp(name), {}, store::test::kTile);
+    store::MapStore map = store::test::NewMapOfManyTiles(store::test::Temp(name));
     test::SequenceSpec spec;
     spec.scans = 5;
     spec.room_half_m = Eigen::Vector3d(6.0, 4.0, 3.0);

@@ -32,7 +32,7 @@ constexpr double kTile = 3.2;  // 32 voxels: a 12 m room spans many tiles
 /// tile allocates OpenVDB's 264 KB top node, which the sanitizers' allocators map and fault in
 /// afresh each time (docs/reliability.md, "Sanitizers"): the room over a quarter of the tiles
 /// halves the store tests' time there and still spans several. Tests that count tiles or cut
-/// regions at tile edges pass kTile.
+/// regions at tile edges use NewMapOfManyTiles.
 inline double TestTile() { return strata::testing::UnderSanitizer() ? 2 * kTile : kTile; }
 
 inline fs::path Temp(const std::string& name) { return strata::test::TempPath("store_" + name); }
@@ -85,6 +85,10 @@ inline MapStore NewMap(const fs::path& dir, const IntegrationConfig& rule = {},
     settings.integration = rule;
     return MapStore::Create(dir, settings);
 }
+
+/// A map in kTile tiles in every build: for the tests that count tiles or cut regions at their
+/// edges.
+inline MapStore NewMapOfManyTiles(const fs::path& dir) { return NewMap(dir, {}, kTile); }
 
 inline SessionRecord Write(MapStore& map, const std::vector<Scan>& scans,
                            SessionOptions options = {}, const IntegrationConfig& rule = {}) {

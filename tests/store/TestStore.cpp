@@ -56,7 +56,7 @@ TEST(Store, SessionsEqualInMemoryIntegrationAndSnapshotsGoBack) {
     const auto first = Session(1, {0, 0, 0});
     const auto second = Session(10, {4.0, 1.0, 0.0});
     {
-        MapStore map = NewMap(dir, {}, kTile);  // many tiles, under a sanitizer too
+        MapStore map = NewMapOfManyTiles(dir);
         const auto s1 = Write(map, first, Named("first"));
         const auto s2 = Write(map, second, Named("second"));
         EXPECT_EQ(s1.id, 1);

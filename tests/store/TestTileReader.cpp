@@ -13,7 +13,7 @@ namespace strata::store::test {
 namespace {
 
 MapStore TwoSessions(const std::string& name) {
-    MapStore map = NewMap(Temp(name), {}, kTile);  // the regions below count 3.2 m tiles
+    MapStore map = NewMapOfManyTiles(Temp(name));  // the regions below count 3.2 m tiles
     (void)Write(map, Session(1, {0, 0, 0}));
     (void)Write(map, Session(10, {4.0, 1.0, 0.0}));
     return map;
