@@ -3,6 +3,9 @@ target_link_libraries(bench_integration PRIVATE Strata::integration Strata::io s
                                                 TBB::tbb)
 strata_use_build_paths(bench_integration)
 strata_set_warnings(bench_integration)
+if(TARGET strata)  # the whole command's rows run `strata integrate`
+  add_dependencies(bench_integration strata)
+endif()
 # The short run in CI: fails when a voxel differs from OctoMap's or a ratio misses its floor.
 # Without the real data it exits 77, a skip (a failure under STRATA_REQUIRE_DATA=1).
 add_test(NAME BenchIntegrationCi COMMAND bench_integration --ci)

@@ -5,6 +5,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
@@ -12,19 +13,29 @@
 #include "ApplyUpdate.hpp"
 #include "RadixSort.hpp"
 #include "RayMarking.hpp"
+#include "Scratch.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::integration {
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point from, Clock::time_point to) {
+    return std::chrono::duration<double>(to - from).count();
+}
+
 // Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted;
 // with `offsets`, the point's index rides along so each group also sums its points' offsets
 // from the voxel centre.
 std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
-                                          const core::SemanticClass* labels, bool offsets) {
+                                          const core::SemanticClass* labels, bool offsets,
+                                          detail::Scratch& scratch) {
     const size_t n = prepared.endpoint_pos.size();
-    std::vector<uint64_t> keys(n);
-    std::vector<uint32_t> points;
+    std::vector<uint64_t>& keys = scratch.keys;
+    std::vector<uint32_t>& points = scratch.points;
+    keys.resize(n);
+    points.clear();
     if (offsets) points.assign(prepared.endpoint_point.begin(), prepared.endpoint_point.end());
     for (size_t i = 0; i < n; ++i) {
         const auto label =
@@ -34,7 +45,7 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
     }
     int key_bits = 8;  // class id
     while ((int64_t{1} << (key_bits - 8)) < prepared.box.size()) ++key_bits;
-    detail::RadixSort(keys, key_bits, points);
+    detail::RadixSort(keys, key_bits, points, scratch.key_buffer, scratch.point_buffer);
     std::vector<EndpointGroup> groups;
     const detail::VoxelBox& box = prepared.box;
     for (size_t i = 0; i < n;) {
@@ -58,15 +69,21 @@ std::vector<EndpointGroup> GroupEndpoints(const detail::PreparedScan& prepared,
 // The update of the rays from one origin (map frame); `labels` is null or one per point.
 ScanUpdate RaysFrom(const std::vector<Eigen::Vector3d>& points_map, const Eigen::Vector3d& origin,
                     const core::SemanticClass* labels, double voxel_size,
-                    const IntegrationConfig& config) {
-    const detail::PreparedScan prepared =
-        detail::PrepareScan(points_map, origin, voxel_size, config);
+                    const IntegrationConfig& config, detail::Scratch& scratch) {
+    const auto start = Clock::now();
+    detail::PreparedScan& prepared = scratch.prepared;
+    detail::PrepareScan(points_map, origin, voxel_size, config, prepared, scratch.pos);
+    const auto prepared_at = Clock::now();
+    scratch.seconds.prepare += Seconds(start, prepared_at);
     // Grouping endpoints (serial) runs beside the parallel ray marking.
     ScanUpdate update;
     detail::ScanMasks masks;
-    tbb::parallel_invoke(
-        [&] { masks = detail::MarkScan(prepared, config); },
-        [&] { update.endpoints = GroupEndpoints(prepared, labels, config.keep_point_means); });
+    tbb::parallel_invoke([&] { masks = detail::MarkScan(prepared, config, scratch.bitmaps); },
+                         [&] {
+                             update.endpoints =
+                                 GroupEndpoints(prepared, labels, config.keep_point_means, scratch);
+                         });
+    scratch.seconds.mark += Seconds(prepared_at, Clock::now());
     update.free = masks.free;
     update.occupied = masks.occupied;
     update.points = points_map.size();
@@ -81,7 +98,7 @@ ScanUpdate RaysFrom(const std::vector<Eigen::Vector3d>& points_map, const Eigen:
 ScanUpdate RaysFromEachOrigin(const core::Scan& scan,
                               const std::vector<Eigen::Vector3d>& points_map,
                               const Eigen::Isometry3d& T_map_sensor, double voxel_size,
-                              const IntegrationConfig& config) {
+                              const IntegrationConfig& config, detail::Scratch& scratch) {
     ScanUpdate all;
     all.free = std::make_shared<openvdb::MaskTree>();
     all.occupied = std::make_shared<openvdb::MaskTree>();
@@ -91,9 +108,9 @@ ScanUpdate RaysFromEachOrigin(const core::Scan& scan,
             r + 1 < scan.ray_origins.size() ? scan.ray_origins[r + 1].begin : points_map.size();
         const std::vector<Eigen::Vector3d> run(points_map.begin() + static_cast<ptrdiff_t>(begin),
                                                points_map.begin() + static_cast<ptrdiff_t>(end));
-        const ScanUpdate part =
-            RaysFrom(run, T_map_sensor * scan.ray_origins[r].origin,
-                     scan.has_labels() ? scan.labels.data() + begin : nullptr, voxel_size, config);
+        const ScanUpdate part = RaysFrom(run, T_map_sensor * scan.ray_origins[r].origin,
+                                         scan.has_labels() ? scan.labels.data() + begin : nullptr,
+                                         voxel_size, config, scratch);
         all.free->topologyUnion(*part.free);
         all.occupied->topologyUnion(*part.occupied);
         all.endpoints.insert(all.endpoints.end(), part.endpoints.begin(), part.endpoints.end());
@@ -158,14 +175,23 @@ void RequireUpdateFits(const ScanUpdate& update, const core::VoxelMap& map,
 
 }  // namespace
 
+ScanWorkspace::ScanWorkspace() : scratch_(std::make_unique<detail::Scratch>()) {}
+ScanWorkspace::~ScanWorkspace() = default;
+ScanWorkspace::ScanWorkspace(ScanWorkspace&&) noexcept = default;
+ScanWorkspace& ScanWorkspace::operator=(ScanWorkspace&&) noexcept = default;
+const UpdateSeconds& ScanWorkspace::seconds() const { return scratch_->seconds; }
+
 ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
-                             const IntegrationConfig& config) {
+                             const IntegrationConfig& config, ScanWorkspace& workspace) {
     config.Validate();
     scan.Validate();
     if (!(map.voxel_size > 0.0)) throw InvalidArgumentError("the map has no voxel size");
+    detail::Scratch& scratch = *workspace.scratch_;
 
     // Map frame = world frame shifted by the map's georeferenced origin.
-    std::vector<Eigen::Vector3d> points_map(scan.points.size());
+    const auto start = Clock::now();
+    std::vector<Eigen::Vector3d>& points_map = scratch.points_map;
+    points_map.resize(scan.points.size());
     const Eigen::Isometry3d T_map_sensor = Eigen::Translation3d(-map.origin) * scan.T_world_sensor;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points_map.size(), 8192),
                       [&](const tbb::blocked_range<size_t>& r) {
@@ -173,17 +199,27 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                               points_map[i] = T_map_sensor * scan.points[i];
                           }
                       });
+    scratch.seconds.prepare += Seconds(start, Clock::now());
 
     // Endpoint-only clouds have no rays, so no origins to tell apart.
     ScanUpdate update =
         scan.ray_origins.size() > 1 && !config.points_only
-            ? RaysFromEachOrigin(scan, points_map, T_map_sensor, map.voxel_size, config)
+            ? RaysFromEachOrigin(scan, points_map, T_map_sensor, map.voxel_size, config, scratch)
             : RaysFrom(points_map,
                        T_map_sensor * (scan.ray_origins.empty() ? Eigen::Vector3d::Zero()
                                                                 : scan.ray_origins[0].origin),
-                       scan.has_labels() ? scan.labels.data() : nullptr, map.voxel_size, config);
+                       scan.has_labels() ? scan.labels.data() : nullptr, map.voxel_size, config,
+                       scratch);
+    const auto checked = Clock::now();
     RequireUpdateFits(update, map, config);
+    scratch.seconds.mark += Seconds(checked, Clock::now());
     return update;
+}
+
+ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
+                             const IntegrationConfig& config) {
+    ScanWorkspace workspace;
+    return ComputeScanUpdate(scan, map, config, workspace);
 }
 
 void ApplyScanUpdate(const ScanUpdate& update, core::VoxelMap& map,
@@ -206,7 +242,7 @@ Integrator::Integrator(core::VoxelMap& map, const IntegrationConfig& config)
 }
 
 ScanUpdate Integrator::Integrate(const core::Scan& scan) {
-    ScanUpdate update = ComputeScanUpdate(scan, map_, config_);
+    ScanUpdate update = ComputeScanUpdate(scan, map_, config_, workspace_);
     ApplyScanUpdate(update, map_, config_);
     return update;
 }

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "RayMarking.hpp"
+#include "Scratch.hpp"
 #include "TraceRay.hpp"
 #include "strata/core/Error.hpp"
 
@@ -22,24 +23,10 @@ namespace {
 using MaskLeaf = openvdb::MaskTree::LeafNodeType;
 constexpr size_t kRayGrain = 2048;
 
-// A zero-filled bitmap from calloc, in 64-bit words: x86 masks a 64-bit shift count itself, so a
-// mark is one instruction shorter than with bytes. On little-endian machines the words read as
-// bytes give bit `pos` at byte pos / 8, bit pos % 8, which is what GatherBrick reads.
+// The bitmaps (Scratch.hpp) are 64-bit words: x86 masks a 64-bit shift count itself, so a mark
+// is one instruction shorter than with bytes. On little-endian machines the words read as bytes
+// give bit `pos` at byte pos / 8, bit pos % 8, which is what GatherBrick reads.
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "bitmap bytes assume little endian");
-struct Bitmap {
-    struct Free {
-        void operator()(uint64_t* p) const { std::free(p); }
-    };
-    std::unique_ptr<uint64_t, Free> words;
-    explicit Bitmap(size_t n_bytes)
-        : words(static_cast<uint64_t*>(std::calloc(n_bytes / 8, sizeof(uint64_t)))) {
-        if (!words) throw std::bad_alloc();
-    }
-    void Set(int64_t pos) { words.get()[pos >> 6] |= uint64_t{1} << (pos & 63); }
-    [[nodiscard]] const uint8_t* bytes() const {
-        return reinterpret_cast<const uint8_t*>(words.get());
-    }
-};
 
 size_t RayCount(const PreparedScan& scan) { return scan.points_only ? 0 : scan.ends.size(); }
 
@@ -86,13 +73,27 @@ bool FindBricks(const VoxelBox& box, const std::vector<const uint64_t*>& bitmaps
     return all != 0;
 }
 
-ScanMasks MarkDense(const PreparedScan& scan, bool wide) {
+// Zeroes the bytes of the column (bx, by, every z) in a bitmap: its 8 x-slabs hold the column's
+// 8 rows of z next to each other. What FindBricks found empty is zero already.
+void ClearColumn(const VoxelBox& box, uint64_t* bits, int64_t bx, int64_t by) {
+    const int64_t row = box.nz >> 3, slab = box.ny * row;
+    auto* bytes = reinterpret_cast<uint8_t*>(bits);
+    for (int64_t x = bx; x < bx + 8; ++x) {
+        std::memset(bytes + x * slab + by * row, 0, static_cast<size_t>(8 * row));
+    }
+}
+
+ScanMasks MarkDense(const PreparedScan& scan, bool wide, Bitmaps& bitmaps) {
     const VoxelBox& box = scan.box;
-    const auto n_bytes = static_cast<size_t>(box.size() / 8);
-    tbb::enumerable_thread_specific<Bitmap> free_bits([n_bytes] { return Bitmap(n_bytes); });
+    const auto n_words = static_cast<size_t>(box.size() / 64);
+    if (!bitmaps.clean) bitmaps.ClearAll();
+    bitmaps.clean = false;
+    for (Bitmap& b : bitmaps.free) b.used = false;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
-                          uint64_t* const bits = free_bits.local().words.get();
+                          Bitmap& mine = bitmaps.free.local();
+                          mine.used = true;
+                          uint64_t* const bits = mine.Zeroed(n_words);
                           const auto mark = [bits](int64_t pos) {
                               bits[pos >> 6] |= uint64_t{1} << (pos & 63);
                           };
@@ -102,16 +103,22 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide) {
                               TraceRays(scan, range, mark, bits);
                           }
                       });
-    Bitmap occupied_bits(n_bytes);
-    for (const int64_t pos : scan.endpoint_pos) occupied_bits.Set(pos);
+    uint64_t* const occupied_words = bitmaps.occupied.Zeroed(n_words);
+    for (const int64_t pos : scan.endpoint_pos) {
+        occupied_words[pos >> 6] |= uint64_t{1} << (pos & 63);
+    }
+    const auto* occupied_bytes = reinterpret_cast<const uint8_t*>(occupied_words);
 
     // Bricks to leaves, parallel over x-slabs of bricks; free minus occupied (occupied wins).
+    // Each column of bricks is cleared once read: the bitmaps are zero again for the next scan.
     std::vector<const uint8_t*> locals;
-    std::vector<const uint64_t*> all_words = {occupied_bits.words.get()};
-    for (const Bitmap& b : free_bits) {
-        locals.push_back(b.bytes());
-        all_words.push_back(b.words.get());
+    std::vector<uint64_t*> all_words = {occupied_words};
+    for (Bitmap& b : bitmaps.free) {
+        if (!b.used) continue;  // a thread that walked no ray of this scan: all zero
+        locals.push_back(reinterpret_cast<const uint8_t*>(b.words.data()));
+        all_words.push_back(b.words.data());
     }
+    const std::vector<const uint64_t*> read_words(all_words.begin(), all_words.end());
     // Each thread fills its own trees; merging them afterwards only moves nodes.
     tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees, occ_trees;
     tbb::parallel_for(tbb::blocked_range<int64_t>(0, box.nx / 8), [&](const auto& range) {
@@ -122,10 +129,10 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide) {
         std::vector<uint8_t> any;
         for (int64_t bx = range.begin() * 8; bx != range.end() * 8; bx += 8) {
             for (int64_t by = 0; by < box.ny; by += 8) {
-                if (!FindBricks(box, all_words, bx, by, acc, any)) continue;
+                if (!FindBricks(box, read_words, bx, by, acc, any)) continue;
                 for (int64_t bz = 0; bz < box.nz; bz += 8) {
                     if (!any[bz >> 3]) continue;
-                    GatherBrick(box, occupied_bits.bytes(), bx, by, bz, occ);
+                    GatherBrick(box, occupied_bytes, bx, by, bz, occ);
                     uint64_t any_free = 0, any_occ = 0;
                     std::memset(fre, 0, sizeof(fre));
                     for (const uint8_t* local : locals) {
@@ -150,9 +157,11 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide) {
                     if (any_free) emit(fre, my_free);
                     if (any_occ) emit(occ, my_occ);
                 }
+                for (uint64_t* bits : all_words) ClearColumn(box, bits, bx, by);
             }
         }
     });
+    bitmaps.clean = true;
     ScanMasks masks;
     for (auto& tree : free_trees) masks.free->merge(tree, openvdb::MERGE_NODES);
     for (auto& tree : occ_trees) masks.occupied->merge(tree, openvdb::MERGE_NODES);
@@ -236,9 +245,9 @@ void RequireSparseMarkingFits(const PreparedScan& scan, const IntegrationConfig&
     }
 }
 
-ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config) {
+ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config, Bitmaps& bitmaps) {
     if (static_cast<uint64_t>(scan.box.size() / 8) <= config.dense_scratch_limit_bytes) {
-        return MarkDense(scan, config.wide_walk && WideWalkAvailable());
+        return MarkDense(scan, config.wide_walk && WideWalkAvailable(), bitmaps);
     }
     // Only a scan too large for the dense scratch can be too large for memory.
     RequireSparseMarkingFits(scan, config);

@@ -58,15 +58,16 @@ VoxelBox MakeBox(openvdb::CoordBBox bbox) {
 
 }  // namespace
 
-PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
-                         const Eigen::Vector3d& origin_map, double voxel_size,
-                         const IntegrationConfig& config) {
+void PrepareScan(const std::vector<Eigen::Vector3d>& points_map, const Eigen::Vector3d& origin_map,
+                 double voxel_size, const IntegrationConfig& config, PreparedScan& scan,
+                 std::vector<int64_t>& pos) {
     const double inv_voxel = 1.0 / voxel_size;
     if (!origin_map.allFinite() || !KeyInRange(origin_map, inv_voxel)) {
         throw InvalidArgumentError(
             "the sensor origin is not finite or too far from the map origin");
     }
-    PreparedScan scan;
+    scan.dropped = 0;
+    scan.clipped = 0;
     scan.float_rays = UseFloatRays(origin_map, inv_voxel, config);
     scan.origin = origin_map;
     if (scan.float_rays) {
@@ -76,9 +77,12 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
     scan.voxel_size = voxel_size;
     scan.inv_voxel_size = inv_voxel;
     scan.points_only = config.points_only;
+    // Every element below is written before it is read: resizing within the capacity the
+    // vectors kept from the scan before costs nothing.
     const size_t n = points_map.size();
     scan.ends.resize(n);
     scan.kinds.resize(n);
+    pos.resize(n);
 
     // Pass 1 (parallel): classify each point, clip long rays, grow the box over the ray ends.
     const auto classify = [&](auto zero, size_t i) {
@@ -110,13 +114,14 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
     scan.box = MakeBox(bbox);
 
     // Pass 2: endpoint voxels (parallel), then kept in scan order (serial, a copy).
-    std::vector<int64_t> pos(n);
     tbb::parallel_for(Range(0, n, kPointGrain), [&](const Range& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
             if (scan.kinds[i] == PointKind::kHit)
                 pos[i] = scan.box.Index(Key(scan.ends[i], inv_voxel));
         }
     });
+    scan.endpoint_pos.clear();
+    scan.endpoint_point.clear();
     scan.endpoint_pos.reserve(n);
     scan.endpoint_point.reserve(n);
     for (size_t i = 0; i < n; ++i) {
@@ -133,7 +138,6 @@ PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
                 break;
         }
     }
-    return scan;
 }
 
 }  // namespace strata::integration::detail

@@ -74,11 +74,12 @@ struct PreparedScan {
     size_t clipped = 0;                    // longer than max_range: free space only
 };
 
-/// Filters points, computes the box and the endpoint voxels (parallel over points).
+/// Filters points, computes the box and the endpoint voxels (parallel over points) into `scan`,
+/// whose vectors keep their memory from the scan before (`pos`: scratch, one per point).
 /// With float rays, points and origin are rounded to float first (OctoMap's point3d).
-[[nodiscard]] PreparedScan PrepareScan(const std::vector<Eigen::Vector3d>& points_map,
-                                       const Eigen::Vector3d& origin_map, double voxel_size,
-                                       const IntegrationConfig& config);
+void PrepareScan(const std::vector<Eigen::Vector3d>& points_map, const Eigen::Vector3d& origin_map,
+                 double voxel_size, const IntegrationConfig& config, PreparedScan& scan,
+                 std::vector<int64_t>& pos);
 
 /// The free and occupied voxels of a scan as VDB masks, free minus occupied (occupied wins).
 struct ScanMasks {
@@ -86,8 +87,11 @@ struct ScanMasks {
     openvdb::MaskTree::Ptr occupied = std::make_shared<openvdb::MaskTree>();
 };
 
-/// Marks every ray with an exact 3D DDA (parallel over rays, thread-local bitmaps merged with OR).
-/// The result does not depend on the number of threads.
-[[nodiscard]] ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config);
+struct Bitmaps;
+
+/// Marks every ray with an exact 3D DDA (parallel over rays, into per-thread bitmaps of
+/// `bitmaps`, merged with OR). The result does not depend on the number of threads.
+[[nodiscard]] ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config,
+                                 Bitmaps& bitmaps);
 
 }  // namespace strata::integration::detail

@@ -50,7 +50,11 @@ IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOpt
     const char* stage = "integrating";
     ReportProgress(options.progress, stage, 0, source.size());
     for (size_t i = 0; i < source.size(); ++i) {
-        (void)writer.Integrate(source.Read(i));  // reader errors name their file already
+        const auto read_start = std::chrono::steady_clock::now();
+        const core::Scan scan = source.Read(i);  // reader errors name their file already
+        result.read_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
+        (void)writer.Integrate(scan);
         ReportProgress(options.progress, stage, i + 1, source.size());
     }
     result.session = writer.Commit();

@@ -73,6 +73,7 @@ struct SessionWriter::State {
     uint64_t clock = 0;
     std::string start_utc;
     bool done = false;
+    integration::ScanWorkspace workspace;  // Compute's memory, kept from scan to scan
     WriterStats stats;
 
     State(MapStore::Impl& i, const MapStore& s, const integration::IntegrationConfig& c,
@@ -101,6 +102,7 @@ struct SessionWriter::State {
     // Writes the files of every tile this writer changed and syncs them: resident dirty tiles
     // now, evicted ones already were. Nothing else is written.
     SessionFiles WriteOwnFiles() {
+        const auto start = std::chrono::steady_clock::now();
         stats.peak_memory_bytes = std::max(stats.peak_memory_bytes, MemoryBytes());
         std::set<TileKey> dirty;
         for (const auto& [key, r] : resident) {
@@ -133,6 +135,8 @@ struct SessionWriter::State {
             out.versions.push_back(v);
             if (!l.file.empty()) out.layers.push_back(l);
         }
+        stats.write_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return out;
     }
 
@@ -334,21 +338,26 @@ integration::ScanUpdate SessionWriter::Integrate(const core::Scan& scan) {
     return update;
 }
 
-integration::ScanUpdate SessionWriter::Compute(const core::Scan& scan) const {
-    const State& s = *state_;
+integration::ScanUpdate SessionWriter::Compute(const core::Scan& scan) {
+    State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
+    integration::ScanUpdate update;
     if (s.options.alignment.isIdentity()) {
-        return integration::ComputeScanUpdate(scan, s.work, s.config);
+        update = integration::ComputeScanUpdate(scan, s.work, s.config, s.workspace);
+    } else {
+        core::Scan aligned = scan;
+        aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
+        update = integration::ComputeScanUpdate(aligned, s.work, s.config, s.workspace);
     }
-    core::Scan aligned = scan;
-    aligned.T_world_sensor = Eigen::Isometry3d(s.options.alignment) * scan.T_world_sensor;
-    return integration::ComputeScanUpdate(aligned, s.work, s.config);
+    s.stats.update_seconds = s.workspace.seconds();
+    return update;
 }
 
 void SessionWriter::Apply(const integration::ScanUpdate& update) {
     State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
     if (s.own_files) throw InvalidArgumentError("the session's files are written already");
+    const auto start = std::chrono::steady_clock::now();
     // A writer that keeps only some tiles applies only their part (updates act voxel by voxel);
     // a part cut for it already (a rank's, docs/scale.md) is not copied again.
     std::optional<integration::ScanUpdate> part;
@@ -370,6 +379,8 @@ void SessionWriter::Apply(const integration::ScanUpdate& update) {
         r.last_use = s.clock;
     }
     s.Evict(keys);
+    s.stats.apply_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void SessionWriter::AddScan(const ScanRecord& scan) {

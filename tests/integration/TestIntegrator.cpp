@@ -254,6 +254,69 @@ TEST(Integrator, WideWalkMatchesOneRayAtATime) {
     ExpectSameGrids(IntegrateRoom(IntegrationConfig{}), IntegrateRoom(narrow));
 }
 
+// One workspace serving scans of every size and kind in turn (ScanWorkspace keeps its bitmaps
+// zero and its buffers sized from scan to scan) gives each scan the update a fresh one gives:
+// a small scan after a large one, a labelled one, one from two origins, one marked sparsely, a
+// scan whose box is over the size a workspace keeps, a refused one, and the room again.
+TEST(Integrator, AWorkspaceGivesEveryScanTheUpdateAFreshOneGives) {
+    core::VoxelMap map = core::VoxelMap::Create(0.1);
+    core::Scan two_origins = RoomScan(5, 3000);
+    const core::Scan b = RoomScan(6, 3000);
+    for (const Eigen::Vector3d& p : b.points) {
+        two_origins.points.push_back(p + Eigen::Vector3d(0.3, 0, 0));
+    }
+    two_origins.ray_origins = {{0, Eigen::Vector3d::Zero()},
+                               {3000, Eigen::Vector3d(0.3, 0.0, 0.0)}};
+    // Rays of 30 m in every direction: a box of 600^2 x 640 voxels, 29 MB of bitmap at 0.1 m,
+    // larger than the rooms' before it.
+    std::vector<Eigen::Vector3d> far;
+    for (int i = 0; i < 200; ++i) {
+        const double a = 0.0314 * i;
+        far.emplace_back(30.0 * std::cos(a), 30.0 * std::sin(a), (i % 2 ? 1.0 : -1.0) * 30.0);
+    }
+    IntegrationConfig sparse;
+    sparse.dense_scratch_limit_bytes = 0;
+    IntegrationConfig tight;
+    tight.max_update_bytes = 1000;  // refuses the room
+    struct Step {
+        core::Scan scan;
+        IntegrationConfig config;
+        bool refused = false;
+    };
+    const std::vector<Step> steps = {
+        {RoomScan(1, 20000), {}},          {RoomScan(2, 500), {}},
+        {LabelledRoomScan(3, 5000), {}},   {two_origins, {}},
+        {RoomScan(4, 8000), sparse},       {MakeScan(far, Eigen::Vector3d::Zero()), {}},
+        {RoomScan(7, 20000), tight, true}, {RoomScan(1, 20000), {}},
+    };
+    ScanWorkspace workspace;
+    for (size_t i = 0; i < steps.size(); ++i) {
+        SCOPED_TRACE("scan " + std::to_string(i));
+        const Step& step = steps[i];
+        if (step.refused) {
+            EXPECT_THROW((void)ComputeScanUpdate(step.scan, map, step.config, workspace),
+                         RefusedError);
+            continue;
+        }
+        const ScanUpdate kept = ComputeScanUpdate(step.scan, map, step.config, workspace);
+        const ScanUpdate fresh = ComputeScanUpdate(step.scan, map, step.config);
+        EXPECT_GT(kept.occupied->activeVoxelCount(), 0u);
+        EXPECT_EQ(ActiveVoxels(*kept.free), ActiveVoxels(*fresh.free));
+        EXPECT_EQ(ActiveVoxels(*kept.occupied), ActiveVoxels(*fresh.occupied));
+        ASSERT_EQ(kept.endpoints.size(), fresh.endpoints.size());
+        for (size_t g = 0; g < kept.endpoints.size(); ++g) {
+            EXPECT_EQ(kept.endpoints[g].ijk, fresh.endpoints[g].ijk);
+            EXPECT_EQ(kept.endpoints[g].label, fresh.endpoints[g].label);
+            EXPECT_EQ(kept.endpoints[g].points, fresh.endpoints[g].points);
+            EXPECT_EQ(kept.endpoints[g].offset_sum, fresh.endpoints[g].offset_sum);
+        }
+        EXPECT_EQ(kept.dropped, fresh.dropped);
+        EXPECT_EQ(kept.clipped, fresh.clipped);
+    }
+    EXPECT_GT(workspace.seconds().prepare, 0.0);
+    EXPECT_GT(workspace.seconds().mark, 0.0);
+}
+
 TEST(Integrator, PointsOnlyMarksEndpointsWithoutFreeSpace) {
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     IntegrationConfig config;

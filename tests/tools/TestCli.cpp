@@ -1,6 +1,7 @@
 // End-to-end tests of the `strata` program: it runs, explains failures, and never damages a map.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -35,8 +36,24 @@ TEST(Cli, IntegrateInfoAndExportEndToEnd) {
     const fs::path seq = MakeSequence(Temp("seq"));
     const fs::path map = Temp("map");
     const Result integrate = Strata("integrate " + map.string() + " --kitti " + seq.string() +
-                                    " --voxel 0.1 --max-range 20");
+                                    " --voxel 0.1 --max-range 20 --profile");
     ASSERT_EQ(integrate.code, 0) << integrate.out;
+    // --profile: where the session's time went, each part once (none counted twice: what is
+    // left, "other", is not negative) and the kernel's parts measured.
+    double read = -1, prepare = -1, mark = -1, apply = -1, write = -1, catalog = -1, other = -1;
+    const size_t at = integrate.out.find("time: reading");
+    ASSERT_NE(at, std::string::npos) << integrate.out;
+    ASSERT_EQ(std::sscanf(integrate.out.c_str() + at,
+                          "time: reading %lf s, preparing %lf s, marking %lf s, applying %lf s, "
+                          "writing tiles %lf s, catalog %lf s, other %lf s",
+                          &read, &prepare, &mark, &apply, &write, &catalog, &other),
+              7)
+        << integrate.out;
+    for (const double part : {read, prepare, mark, apply, write, catalog}) EXPECT_GE(part, 0.0);
+    EXPECT_GT(prepare, 0.0);
+    EXPECT_GT(mark, 0.0);
+    EXPECT_GT(write, 0.0);
+    EXPECT_GE(other, -1e-9) << integrate.out;
 
     const Result info = Strata("info " + map.string() + " --json");
     ASSERT_EQ(info.code, 0) << info.out;

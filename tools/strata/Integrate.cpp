@@ -32,7 +32,21 @@ struct IntegrateArgs {
     bool odometry = false;
     std::string poses_out;
     std::string on_failure = "stop";
+    bool profile = false;
 };
+
+// Where the session's time went (--profile; docs/integration.md, "Where the whole command's time
+// goes"). The rest is opening the map and the scans, progress and the session's bookkeeping.
+void PrintProfile(const pipeline::IntegrateResult& r) {
+    const store::WriterStats& s = r.stats;
+    const double catalog = s.commit_seconds - s.write_seconds;
+    const double other = r.seconds - r.read_seconds - s.update_seconds.prepare -
+                         s.update_seconds.mark - s.apply_seconds - s.commit_seconds;
+    std::cout << "time: reading " << r.read_seconds << " s, preparing " << s.update_seconds.prepare
+              << " s, marking " << s.update_seconds.mark << " s, applying " << s.apply_seconds
+              << " s, writing tiles " << s.write_seconds << " s, catalog " << catalog
+              << " s, other " << other << " s\n";
+}
 
 // The map the flags ask for: only the flags the user gave are checked against an existing map.
 pipeline::MapRequest MapRequestOf(const IntegrateArgs& args, const CLI::App& cmd) {
@@ -119,6 +133,7 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
               << r.stats.tiles_written << " tile files (" << r.stats.bytes_written / 1e6
               << " MB), commit " << r.stats.commit_seconds << " s; map has " << r.map_tiles
               << " tiles\n";
+    if (args.profile && CommandRanks().size() == 1) PrintProfile(r);
     if (CommandRanks().size() > 1) {
         std::cout << "rank 0 of " << CommandRanks().size() << ": " << r.steps.cast
                   << " s reading and casting its scans, " << r.steps.exchange
@@ -162,6 +177,9 @@ void RegisterIntegrate(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")
         ->capture_default_str();
+    cmd->add_flag("--profile", args->profile,
+                  "Also say where the time went: reading, preparing, marking, applying, writing, "
+                  "the catalog");
     cmd->add_flag("--points-only", args->config.points_only,
                   "Endpoints only, no free space (clouds without a sensor origin)");
     cmd->add_flag(

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "strata/core/GridTypes.hpp"
@@ -30,10 +31,47 @@ struct ScanUpdate {
     size_t clipped = 0;  ///< beyond max_range_m: cleared free space, recorded no hit
 };
 
+namespace detail {
+struct Scratch;
+}
+
+/// @brief Where ComputeScanUpdate's time went, summed over the scans one workspace served.
+struct UpdateSeconds {
+    /// Points into the map frame, filtered and clipped; the scan's voxel box; endpoint voxels.
+    double prepare = 0.0;
+    /// Rays walked into bitmaps and turned into the free and occupied masks, endpoints grouped
+    /// by voxel beside them; the update's size checked against the budget.
+    double mark = 0.0;
+};
+
+/// @brief The working memory of ComputeScanUpdate, kept from one scan to the next (docs/
+/// integration.md, "Where the whole command's time goes"): it grows to the largest scan it
+/// served, so that a drive's scans neither allocate nor fault in their buffers afresh. One per
+/// sequence of calls: a workspace is not shared by calls running at the same time.
+class ScanWorkspace {
+public:
+    ScanWorkspace();
+    ~ScanWorkspace();
+    ScanWorkspace(ScanWorkspace&&) noexcept;
+    ScanWorkspace& operator=(ScanWorkspace&&) noexcept;
+
+    [[nodiscard]] const UpdateSeconds& seconds() const;
+
+private:
+    friend ScanUpdate ComputeScanUpdate(const core::Scan&, const core::VoxelMap&,
+                                        const IntegrationConfig&, ScanWorkspace&);
+    std::unique_ptr<detail::Scratch> scratch_;
+};
+
 /// @brief Computes the update of one scan against a map's voxel grid (the map is not modified).
-/// Parallel over rays (TBB); the result does not depend on the number of threads.
+/// Parallel over rays (TBB); the result does not depend on the number of threads, nor on the
+/// scans `workspace` served before.
 /// @throw InvalidArgumentError on an invalid config or scan; RefusedError when one scan would
 /// grow the map by more than IntegrationConfig::max_update_bytes.
+[[nodiscard]] ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
+                                           const IntegrationConfig& config,
+                                           ScanWorkspace& workspace);
+/// @brief The same in a workspace of its own, given back when it returns.
 [[nodiscard]] ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                                            const IntegrationConfig& config);
 
@@ -58,10 +96,13 @@ public:
     ScanUpdate Integrate(const core::Scan& scan);
 
     [[nodiscard]] const IntegrationConfig& config() const { return config_; }
+    /// @brief Where the scans' updates spent their time so far.
+    [[nodiscard]] const UpdateSeconds& seconds() const { return workspace_.seconds(); }
 
 private:
     core::VoxelMap& map_;
     IntegrationConfig config_;
+    ScanWorkspace workspace_;
 };
 
 }  // namespace strata::integration

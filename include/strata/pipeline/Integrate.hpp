@@ -58,7 +58,8 @@ struct IntegrateOptions {
 struct IntegrateResult {
     store::SessionRecord session;
     store::WriterStats stats;
-    double seconds = 0.0;                ///< integrating and committing, not aligning
+    double seconds = 0.0;       ///< integrating and committing, not aligning
+    double read_seconds = 0.0;  ///< of `seconds`, reading the scans (one process; not on ranks)
     RankedSessionResult::Seconds steps;  ///< where this rank's time went
     size_t map_tiles = 0;                ///< tiles of the map after the commit
     bool created = false;

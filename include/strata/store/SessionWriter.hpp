@@ -46,7 +46,11 @@ struct WriterStats {
     size_t layers_written = 0;     ///< layer files of this session written, evictions included
     uint64_t bytes_written = 0;    ///< fused and layer files together
     size_t peak_memory_bytes = 0;  ///< largest working set seen (grids of loaded tiles)
-    double commit_seconds = 0.0;
+    integration::UpdateSeconds update_seconds;  ///< computing the scans' updates (Compute)
+    /// Applying updates (Apply): tiles made resident (read back) and evicted (written) included.
+    double apply_seconds = 0.0;
+    double write_seconds = 0.0;   ///< the session's tile and layer files written and synced
+    double commit_seconds = 0.0;  ///< the commit: the files (write_seconds) and the catalog
 };
 
 /// @brief What one writer of a session wrote: its tiles' files, written and synced, for the
@@ -79,8 +83,9 @@ public:
     /// Integrates one scan: Compute, Apply, AddScan; returns the whole update.
     integration::ScanUpdate Integrate(const core::Scan& scan);
     /// The update of one scan (moved by the session's alignment) against this writer's map,
-    /// not applied: what a process that shares the session computes for the others.
-    [[nodiscard]] integration::ScanUpdate Compute(const core::Scan& scan) const;
+    /// not applied: what a process that shares the session computes for the others. Its working
+    /// memory stays with the writer for the next scan (integration::ScanWorkspace).
+    [[nodiscard]] integration::ScanUpdate Compute(const core::Scan& scan);
     /// Applies the part of an update (computed here or by another process) that falls in the
     /// tiles this writer keeps. Updates must come in the order of their scans.
     void Apply(const integration::ScanUpdate& update);
