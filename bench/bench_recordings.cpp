@@ -10,12 +10,16 @@
 //   - `integrate --bag` against `integrate --kitti` of the same scans, the whole use case
 //     (pipeline::IntegrateSession: reading, posing, integrating, committing), one thread
 //     (target: within 10 %; --ci holds it at kMaxBagOverKittiCi, CI's machines being busy).
-// The median of --repeat runs (default 5; --ci: 3, the CTest entry BenchRecordingsCi). Exit 1
-// when a target is missed, 77 without KITTI 00 (1 under STRATA_REQUIRE_DATA=1).
+// The median of --repeat runs (default 5, as --ci, the CTest entry BenchRecordingsCi); the
+// integrate ratio compares the fastest run of each, alternated: a run of 0.3-0.5 s beside other
+// tests is only ever slowed by them, and the medians of three gave 1.35x in a CI run where the
+// same build gives 0.89-1.04x quiet (2026-12-06). Exit 1 when a target is missed, 77 without
+// KITTI 00 (1 under STRATA_REQUIRE_DATA=1).
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -138,7 +142,7 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
-        if (arg == "--ci") ci = true, repeat = 3;
+        if (arg == "--ci") ci = true;
     }
     const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
     const fs::path dir =
@@ -180,7 +184,8 @@ int main(int argc, char** argv) {
         k_runs.push_back(IntegrateSeconds(kitti, dir / "kitti.strata"));
         b_runs.push_back(IntegrateSeconds(bag, dir / "bag.strata"));
     }
-    const double k = bench::Median(k_runs), b = bench::Median(b_runs);
+    const double k = *std::min_element(k_runs.begin(), k_runs.end());
+    const double b = *std::min_element(b_runs.begin(), b_runs.end());
     const double most = ci ? kMaxBagOverKittiCi : kMaxBagOverKitti;
     std::printf("integrate --kitti %.3f s, --bag (uncompressed) %.3f s: %.3fx (at most %.2f)%s\n",
                 k, b, b / k, most, b / k > most ? "  MISSED" : "");
