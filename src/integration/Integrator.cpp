@@ -5,7 +5,6 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
@@ -14,16 +13,14 @@
 #include "RadixSort.hpp"
 #include "RayMarking.hpp"
 #include "Scratch.hpp"
+#include "strata/core/Elapsed.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::integration {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point from, Clock::time_point to) {
-    return std::chrono::duration<double>(to - from).count();
-}
+using core::Clock;
+using core::SecondsSince;
 
 // Groups the endpoints by voxel and class: one key per point, (box index << 8 | class), sorted;
 // with `offsets`, the point's index rides along so each group also sums its points' offsets
@@ -73,8 +70,8 @@ ScanUpdate RaysFrom(const std::vector<Eigen::Vector3d>& points_map, const Eigen:
     const auto start = Clock::now();
     detail::PreparedScan& prepared = scratch.prepared;
     detail::PrepareScan(points_map, origin, voxel_size, config, prepared, scratch.pos);
+    scratch.seconds.prepare += SecondsSince(start);
     const auto prepared_at = Clock::now();
-    scratch.seconds.prepare += Seconds(start, prepared_at);
     // Grouping endpoints (serial) runs beside the parallel ray marking.
     ScanUpdate update;
     detail::ScanMasks masks;
@@ -83,7 +80,7 @@ ScanUpdate RaysFrom(const std::vector<Eigen::Vector3d>& points_map, const Eigen:
                              update.endpoints =
                                  GroupEndpoints(prepared, labels, config.keep_point_means, scratch);
                          });
-    scratch.seconds.mark += Seconds(prepared_at, Clock::now());
+    scratch.seconds.mark += SecondsSince(prepared_at);
     update.free = masks.free;
     update.occupied = masks.occupied;
     update.points = points_map.size();
@@ -199,7 +196,7 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                               points_map[i] = T_map_sensor * scan.points[i];
                           }
                       });
-    scratch.seconds.prepare += Seconds(start, Clock::now());
+    scratch.seconds.prepare += SecondsSince(start);
 
     // Endpoint-only clouds have no rays, so no origins to tell apart.
     ScanUpdate update =
@@ -212,7 +209,7 @@ ScanUpdate ComputeScanUpdate(const core::Scan& scan, const core::VoxelMap& map,
                        scratch);
     const auto checked = Clock::now();
     RequireUpdateFits(update, map, config);
-    scratch.seconds.mark += Seconds(checked, Clock::now());
+    scratch.seconds.mark += SecondsSince(checked);
     return update;
 }
 

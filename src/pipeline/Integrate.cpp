@@ -1,10 +1,10 @@
 #include "strata/pipeline/Integrate.hpp"
 
-#include <chrono>
 #include <iomanip>
 #include <optional>
 #include <sstream>
 
+#include "strata/core/Elapsed.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/NewSession.hpp"
 #include "strata/pipeline/RankedSession.hpp"
@@ -45,21 +45,19 @@ IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOpt
     }
     if (options.on_start) options.on_start({map, source, opened.created, opened.rule});
 
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = core::Clock::now();
     NewSession writer(map, opened.rule, session);
     const char* stage = "integrating";
     ReportProgress(options.progress, stage, 0, source.size());
     for (size_t i = 0; i < source.size(); ++i) {
-        const auto read_start = std::chrono::steady_clock::now();
+        const auto read_start = core::Clock::now();
         const core::Scan scan = source.Read(i);  // reader errors name their file already
-        result.read_seconds +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
+        result.read_seconds += core::SecondsSince(read_start);
         (void)writer.Integrate(scan);
         ReportProgress(options.progress, stage, i + 1, source.size());
     }
     result.session = writer.Commit();
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds = core::SecondsSince(start);
     result.stats = writer.stats();
     result.map_tiles = map.Latest().tiles.size();
     return result;
@@ -126,7 +124,7 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
         if (ranks.root() && options.on_start) {
             options.on_start({map, *source, created, opened->rule});
         }
-        const auto start = std::chrono::steady_clock::now();
+        const auto start = core::Clock::now();
         const char* stage = "integrating";
         if (ranks.root()) ReportProgress(options.progress, stage, 0, source->size());
         const RankedSessionResult r = IntegrateOnRanks(
@@ -136,8 +134,7 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
         result.session = r.session;
         result.stats = r.stats;
         result.steps = r.seconds;
-        result.seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.seconds = core::SecondsSince(start);
         result.map_tiles = map.Latest().tiles.size();
         return result;
     } catch (...) {

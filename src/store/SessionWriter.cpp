@@ -5,7 +5,6 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
 #include <map>
 #include <optional>
 #include <set>
@@ -16,6 +15,7 @@
 #include "MapStoreImpl.hpp"
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
+#include "strata/core/Elapsed.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/OccupancyMasks.hpp"
 #include "strata/core/ParallelFor.hpp"
@@ -102,7 +102,7 @@ struct SessionWriter::State {
     // Writes the files of every tile this writer changed and syncs them: resident dirty tiles
     // now, evicted ones already were. Nothing else is written.
     SessionFiles WriteOwnFiles() {
-        const auto start = std::chrono::steady_clock::now();
+        const auto start = core::Clock::now();
         stats.peak_memory_bytes = std::max(stats.peak_memory_bytes, MemoryBytes());
         std::set<TileKey> dirty;
         for (const auto& [key, r] : resident) {
@@ -135,8 +135,7 @@ struct SessionWriter::State {
             out.versions.push_back(v);
             if (!l.file.empty()) out.layers.push_back(l);
         }
-        stats.write_seconds +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        stats.write_seconds += core::SecondsSince(start);
         return out;
     }
 
@@ -357,7 +356,7 @@ void SessionWriter::Apply(const integration::ScanUpdate& update) {
     State& s = *state_;
     if (s.done) throw InvalidArgumentError("the session is committed already");
     if (s.own_files) throw InvalidArgumentError("the session's files are written already");
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = core::Clock::now();
     // A writer that keeps only some tiles applies only their part (updates act voxel by voxel);
     // a part cut for it already (a rank's, docs/scale.md) is not copied again.
     std::optional<integration::ScanUpdate> part;
@@ -379,8 +378,7 @@ void SessionWriter::Apply(const integration::ScanUpdate& update) {
         r.last_use = s.clock;
     }
     s.Evict(keys);
-    s.stats.apply_seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    s.stats.apply_seconds += core::SecondsSince(start);
 }
 
 void SessionWriter::AddScan(const ScanRecord& scan) {
@@ -425,7 +423,7 @@ SessionRecord SessionWriter::Commit(const std::vector<SessionFiles>& workers) {
             "a worker of a session writes its files (WriteFiles); the "
             "process holding the writer lock commits them");
     }
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = core::Clock::now();
     // On failure the workers' files go with this writer's: nothing will reference them.
     for (const SessionFiles& w : workers) {
         for (const TileVersion& v : w.versions) s.written_files.insert(v.file);
@@ -472,8 +470,7 @@ SessionRecord SessionWriter::Commit(const std::vector<SessionFiles>& workers) {
         tx.Commit();
     }
     s.Finish();
-    s.stats.commit_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    s.stats.commit_seconds = core::SecondsSince(start);
     return record;
 }
 

@@ -1,7 +1,6 @@
 #include "strata/vehicles/Vehicles.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -12,6 +11,7 @@
 #include <utility>
 
 #include "Cars.hpp"
+#include "strata/core/Elapsed.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
 #include "strata/vehicles/VehicleStages.hpp"
@@ -30,10 +30,6 @@ VehicleSource Resolve(const core::VoxelMap& map, VehicleSource wanted) {
         if (*it == vehicle) return VehicleSource::kLabel;
     }
     return VehicleSource::kGeometric;
-}
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
@@ -168,7 +164,7 @@ double Vehicle::YawDeg() const { return footprint.yaw_rad * kRadToDeg; }
 
 VehicleResult ClearVehicles(core::VoxelMap& map, const std::vector<Eigen::Vector3d>& origins_map,
                             const VehicleConfig& config) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = core::Clock::now();
     detail::Validate(map, config);
     VehicleResult result;
     result.source = Resolve(map, config.source);
@@ -194,7 +190,7 @@ VehicleResult ClearVehicles(core::VoxelMap& map, const std::vector<Eigen::Vector
     detail::ClearAndRefill(map, cars, ground, *set.kept, check.get(), *result.cleared,
                            *result.refilled, config);
     for (const detail::Car& car : cars) result.vehicles.push_back(car.object.vehicle);
-    result.seconds = SecondsSince(start);
+    result.seconds = core::SecondsSince(start);
     return result;
 }
 

@@ -1,10 +1,10 @@
 #include "strata/walls/Walls.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <string>
 #include <utility>
 
+#include "strata/core/Elapsed.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/geometry/Clustering.hpp"
 
@@ -16,10 +16,6 @@ int PartsFor(size_t n, int divisor) {
 }
 
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point since) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 void Require(bool ok, const char* what) {
     if (!ok) throw InvalidArgumentError(std::string("wall config: ") + what);
@@ -83,14 +79,14 @@ WallResult FindWalls(const core::VoxelMap& map, const WallConfig& config) {
     voted.voxel_size = s;
 
     // 1. Column statistics, the ground and the votes.
-    const auto t = std::chrono::steady_clock::now();
+    const auto t = core::Clock::now();
     const int radius = WindowRadius(s, config);
     const columns::ColumnGrid cols = columns::ColumnGrid::FromMap(map);
     voted.stats.occupied_columns = cols.OccupiedColumns();
     voted.ground = EstimateGround(map, cols, config.seed);
     const std::vector<openvdb::Coord> candidates =
         VoteCandidates(map, cols.Window(radius), radius, config, &voted.stats.voting_columns);
-    voted.stats.seconds_columns = SecondsSince(t);
+    voted.stats.seconds_columns = core::SecondsSince(t);
     return FindWallsAmong(map, candidates, std::move(voted), config);
 }
 
