@@ -142,7 +142,13 @@ store::SessionFiles FilesFrom(const std::string& text) {
     }
     const auto s = j.at("stats").get<std::vector<uint64_t>>();
     if (s.size() != 6) throw FormatError("a rank's session files without their 6 counts");
-    files.stats = {s[0], s[1], s[2], s[3], s[4], s[5], 0.0};
+    store::WriterStats& stats = files.stats;  // the timings stay with the rank that measured them
+    stats.tiles_loaded = s[0];
+    stats.tiles_evicted = s[1];
+    stats.tiles_written = s[2];
+    stats.layers_written = s[3];
+    stats.bytes_written = s[4];
+    stats.peak_memory_bytes = s[5];
     return files;
 }
 
