@@ -118,7 +118,7 @@ int64_t MapStore::CommitProduct(const ProductCommit& product) {
     for (const auto& g : product.grids) {
         g->apply<core::GridTypes>([&](const auto& typed) {
             auto copy = typed.deepCopy();
-            copy->tree().voxelizeActiveTiles();
+            detail::VoxelizeActiveTiles(copy->tree());
             for (auto& [key, piece] : detail::StealTiles(*copy, impl.settings, &keys)) {
                 if (!piece->empty()) by_tile[key].push_back(piece);
             }

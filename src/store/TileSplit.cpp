@@ -63,7 +63,7 @@ void MergeMap(core::VoxelMap& into, core::VoxelMap& tile) {
 
 void VoxelizeTiles(core::VoxelMap& map) {
     for (const auto& g : map.Grids()) {
-        g->apply<core::GridTypes>([](auto& typed) { typed.tree().voxelizeActiveTiles(); });
+        g->apply<core::GridTypes>([](auto& typed) { VoxelizeActiveTiles(typed.tree()); });
     }
 }
 

@@ -36,11 +36,19 @@ std::map<TileKey, typename GridT::Ptr> StealTiles(GridT& from, const MapSettings
     return out;
 }
 
+/// Turns the active tiles above leaf level into leaves. The check comes first: a tile read from
+/// disk holds none, and OpenVDB's voxelization visits every entry of every internal node (32,768
+/// in each top node) whether or not one is a tile.
+template <typename TreeT>
+void VoxelizeActiveTiles(TreeT& tree) {
+    if (tree.hasActiveTiles()) tree.voxelizeActiveTiles();
+}
+
 /// Moves every leaf of `from` into `into` (their leaves must not overlap).
 template <typename GridT>
 void MergeLeaves(GridT& into, GridT& from) {
     using LeafT = typename GridT::TreeType::LeafNodeType;
-    from.tree().voxelizeActiveTiles();
+    VoxelizeActiveTiles(from.tree());
     std::vector<LeafT*> leaves;
     from.tree().stealNodes(leaves);
     for (LeafT* leaf : leaves) into.tree().addLeaf(leaf);

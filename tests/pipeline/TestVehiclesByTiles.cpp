@@ -75,7 +75,7 @@ TEST(VehiclesByTiles, TileByTileClearsTheWholeMapsVehicles) {
         std::set<std::pair<int, int>> tiles;
         for (const Eigen::Vector2d& c : v.footprint.Corners()) {
             tiles.insert(
-                {int(std::floor(c.x() / kSmallTileM)), int(std::floor(c.y() / kSmallTileM))});
+                {int(std::floor(c.x() / SmallTileM())), int(std::floor(c.y() / SmallTileM()))});
         }
         crossing += tiles.size() > 1;
     }
