@@ -126,8 +126,9 @@ inline const SimulatedScene& BuildingMap(const fs::path& dir, int scans) {
 }
 
 /// Tile edge of StreetInSmallTiles: its facades and parked cars cross many tile borders. Under a
-/// sanitizer twice that (a quarter of the tiles), still many borders: every tile read costs a
-/// sanitizer far more than it costs a release build (docs/reliability.md, "Sanitizers").
+/// sanitizer 1.5 times that (less than half the tiles; 12.8 m would make a tile's halo exceed the
+/// tests' budget): every tile read costs a sanitizer far more than it costs a release build
+/// (docs/reliability.md, "Sanitizers").
 inline double SmallTileM() { return strata::testing::UnderSanitizer() ? 9.6 : 6.4; }
 
 /// datasets/scenes/street.json, 12 scans, integrated in SmallTileM() tiles, once per process:

@@ -152,8 +152,9 @@ TEST(MpiCli, VehiclesOnTwoAndThreeRanksAreTheOneProcessVehicles) {
                   .code,
               0);
     // Tiles of 3.2 m: the parked cars cross tile borders; a short ray range keeps the blocks'
-    // windows smaller than the garage. Under a sanitizer 4.8 m: every tile read costs it far
-    // more than a release build (docs/reliability.md, "Sanitizers"), and cars still cross.
+    // windows smaller than the garage. Under a sanitizer 4.8 m, still many tiles for the ranks
+    // to share: every tile read costs it far more than a release build (docs/reliability.md,
+    // "Sanitizers").
     const std::string tile = strata::testing::UnderSanitizer() ? "4.8" : "3.2";
     ASSERT_EQ(Strata("integrate " + map.string() + " --kitti " + seq.string() +
                      " --voxel 0.1 --tile-size " + tile)
