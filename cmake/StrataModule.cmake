@@ -13,6 +13,7 @@ function(strata_add_module)
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   strata_set_warnings(${target})
+  strata_pch(${target} library)
   strata_unity(${target})
 endfunction()
 
@@ -26,6 +27,7 @@ function(strata_test_program target)
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   target_compile_options(${target} PRIVATE $<$<NOT:$<CONFIG:Debug>>:-O1>)
   strata_set_warnings(${target})
+  strata_pch(${target} test)
 endfunction()
 
 # strata_add_gtest(<name> <sources...> LINKS <targets...> [TSAN_SOURCES <sources...>]): one test
