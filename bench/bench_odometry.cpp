@@ -5,8 +5,9 @@
 // measured while driving, deskewed by the odometry. Reports the CPU milliseconds a sweep takes:
 // the median, and the median of each hundred sweeps with the local map's largest size there. A
 // sweep's cost follows the scene (returns in range, iterations), which varies along the route;
-// what must not happen is growth with the drive's length: the slowest hundred of sweeps 500-999
-// may be at most kMaxGrowth slower than the slowest of 100-499. Targets: <= 50 ms a HDL-64 sweep
+// what must not happen is growth with the drive's length: the median sweep of 500-999 may be at
+// most kMaxGrowth slower than the median sweep of 100-499 (medians of five and four hundred
+// sweeps: one hundred slowed by the machine moves neither). Targets: <= 50 ms a HDL-64 sweep
 // on one core; the district's median is held at kMaxDriveMs, about 2.5x what docs/bench.md
 // reports. Exit 1 on a miss, 77 without KITTI 00 (1 under STRATA_REQUIRE_DATA=1).
 #include <tbb/global_control.h>
@@ -29,8 +30,11 @@ using namespace strata;  // NOLINT(google-build-using-namespace): benchmark prog
 constexpr double kMaxMsPerSweep = 50.0;
 constexpr double kMaxDriveMs = 25.0;   // measured 8.9 ms (AMD EPYC, 2026-12-05)
 constexpr double kMaxMovingMs = 40.0;  // measured 15.6 ms (AMD EPYC, 2026-12-05)
-constexpr double kMaxGrowth =
-    1.5;  // "flat": measured 1.16 (the second half's slowest hundred, the first's)
+// "Flat": the median sweep of 500-999 against that of 100-499. Until 2026-12-06 the slowest
+// hundred of each half was compared (measured 1.16x); in a cold CI run on the AMD EPYC kind,
+// sweeps 900-999 took 27.9 ms of CPU a sweep against 10.8-15.3 for the other hundreds after 500,
+// with the local map no larger than at sweeps 300-399 (1.65x: the machine, not the map).
+constexpr double kMaxGrowth = 1.5;
 
 // CPU seconds this process has used: a sweep's cost on its one thread, which other processes on
 // a shared machine do not lengthen as they do its wall time (a cold CI run saw one hundred of
@@ -86,21 +90,18 @@ int main() {
     const bool slow = median > std::min(kMaxMsPerSweep, kMaxDriveMs);
     std::printf("district drive, %zu HDL-64 sweeps: %.1f ms a sweep (median; held at %.0f)%s\n", n,
                 median, kMaxDriveMs, slow ? "  MISSED" : "");
-    double first_half = 0.0, second_half = 0.0;  // the slowest hundred of each
     for (size_t begin = 100; begin + 100 <= n; begin += 100) {
-        const double m = MedianOf(ms, begin, begin + 100);
         const size_t most = *std::max_element(cells.begin() + static_cast<long>(begin),
                                               cells.begin() + static_cast<long>(begin + 100));
         std::printf("  sweeps %zu-%zu: %.1f ms, the local map up to %zu cells\n", begin, begin + 99,
-                    m, most);
-        double& slowest = begin < n / 2 ? first_half : second_half;
-        slowest = std::max(slowest, m);
+                    MedianOf(ms, begin, begin + 100), most);
     }
+    const double first_half = MedianOf(ms, 100, n / 2), second_half = MedianOf(ms, n / 2, n);
     const bool grew = second_half > kMaxGrowth * first_half;
     std::printf(
-        "  the slowest hundred from sweep %zu on: %.1f ms, before: %.1f ms: x%.2f (held "
+        "  the median sweep from sweep %zu on: %.1f ms, from 100 to %zu: %.1f ms: x%.2f (held "
         "at %.2f)%s\n",
-        n / 2, second_half, first_half, second_half / first_half, kMaxGrowth,
+        n / 2, second_half, n / 2 - 1, first_half, second_half / first_half, kMaxGrowth,
         grew ? "  MISSED" : "");
     missed |= slow || grew;
 
