@@ -13,6 +13,15 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
     const auto start = std::chrono::steady_clock::now();
     registration::Odometry odometry(options.config);
     EstimatedTrajectory out;
+    const recordings::RecordedScans* recording = source.recording();
+    if (recording != nullptr && !recording->imu().angular_velocity.empty()) {
+        const recordings::ImuReadings& imu = recording->imu();
+        try {
+            odometry.PredictRotationBy(registration::Gyro(imu.times_s, imu.angular_velocity));
+        } catch (const InvalidArgumentError& e) {  // readings out of order: a broken recording
+            out.gyro_failure = e.what();
+        }
+    }
     ReportProgress(options.progress, "odometry", 0, source.size());
     for (size_t i = 0; i < source.size(); ++i) {
         const core::Scan scan = source.Read(i);
@@ -36,6 +45,7 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
                 out.degenerate.push_back("scan " + std::to_string(i) + " (" + scan.source +
                                          "): " + step.degenerate);
             }
+            if (step.gyro) ++out.gyro_predicted;
             out.poses.push_back(step.T_world_sensor);
             out.times_s.push_back(scan.time_s);
             out.scans.push_back(i);
@@ -43,7 +53,7 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
         ReportProgress(options.progress, "odometry", i + 1, source.size());
     }
     if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
-    if (const recordings::RecordedScans* recording = source.recording()) {
+    if (recording != nullptr) {
         const recordings::ImuReadings& imu = recording->imu();
         out.imu_note = imu.note;
         if (!imu.topic.empty()) {
@@ -72,6 +82,17 @@ std::vector<std::string> OdometryWarnings(const EstimatedTrajectory& t) {
         }
     }
     return lines;
+}
+
+std::string DescribePrediction(const EstimatedTrajectory& t) {
+    if (t.gyro_predicted == 0) {
+        return "prediction: constant velocity" +
+               (t.gyro_failure.empty() ? std::string()
+                                       : " (the IMU's gyro was not used: " + t.gyro_failure + ")");
+    }
+    // The first scan has no prediction; a scan whose span the readings miss keeps the model's.
+    return "prediction: rotation from the IMU's gyro (" + std::to_string(t.gyro_predicted) +
+           " of " + std::to_string(t.poses.size()) + " scans), translation at constant velocity";
 }
 
 std::string DescribeGravity(const EstimatedTrajectory& t) {

@@ -1,4 +1,5 @@
-// Scan-to-map odometry (docs/odometry.md, "Method"): a constant-velocity prediction, then
+// Scan-to-map odometry (docs/odometry.md, "Method"): a constant-velocity prediction (its rotation
+// from the gyro when there is one), then
 // Gauss-Newton on the distance of each point to the map's plane, line or point around its nearest
 // map point, under a Geman-McClure kernel, with the correspondence distance adapted to how far
 // scans deviate from the prediction; the registered scan then joins a local map that forgets what
@@ -239,6 +240,7 @@ struct Odometry::State {
     OdometryConfig config;
     std::optional<Eigen::Isometry3d> T_world_first;  // else levelled by the first scan's ground
     detail::LocalMap map;
+    std::optional<Gyro> gyro;  // the prediction's rotation, where its readings cover the span
     std::vector<Eigen::Isometry3d> poses;
     std::vector<double> stamps;  // their instants, NaN when unknown
     // The first scan as measured, kept while it is the map's only scan: once the second is
@@ -267,15 +269,30 @@ struct Odometry::State {
         if (tb > ta) *interval = tb - ta;  // false for NaN
         return poses[poses.size() - 2].inverse() * poses.back();
     }
-    // The pose at instant `t` (NaN: the next scan at the steady rate) at the last motion's
-    // velocity.
-    [[nodiscard]] Eigen::Isometry3d Prediction(double t) const {
-        if (poses.empty()) return T_world_first.value_or(Eigen::Isometry3d::Identity());
+    // The sensor's motion from the last pose to instant `t` (NaN: the next scan at the steady
+    // rate): the last motion's velocity, its rotation replaced by the gyro's over the span where
+    // the readings cover it (`by_gyro` then set). The identity before two poses without a gyro.
+    [[nodiscard]] Eigen::Isometry3d PredictedMotion(double t, bool* by_gyro) const {
+        *by_gyro = false;
         double interval = 0.0;
         const Eigen::Isometry3d delta = LastMotion(&interval);
-        if (interval == 0.0 || !std::isfinite(t)) return poses.back() * delta;
-        return poses.back() * core::Interpolate(Eigen::Isometry3d::Identity(), delta,
-                                                (t - stamps.back()) / interval);
+        Eigen::Isometry3d motion = interval == 0.0 || !std::isfinite(t)
+                                       ? delta
+                                       : core::Interpolate(Eigen::Isometry3d::Identity(), delta,
+                                                           (t - stamps.back()) / interval);
+        if (gyro && std::isfinite(t) && std::isfinite(stamps.back())) {
+            if (const std::optional<Eigen::Matrix3d> R = gyro->Rotation(stamps.back(), t)) {
+                motion.linear() = *R;
+                *by_gyro = true;
+            }
+        }
+        return motion;
+    }
+    // The pose at instant `t` (as PredictedMotion), where the world's first scan goes before any.
+    [[nodiscard]] Eigen::Isometry3d Prediction(double t, bool* by_gyro) const {
+        *by_gyro = false;
+        if (poses.empty()) return T_world_first.value_or(Eigen::Isometry3d::Identity());
+        return poses.back() * PredictedMotion(t, by_gyro);
     }
     [[nodiscard]] double Sigma() const {
         return errors == 0 ? config.initial_threshold_m
@@ -331,6 +348,8 @@ Odometry& Odometry::operator=(Odometry&&) noexcept = default;
 const std::vector<Eigen::Isometry3d>& Odometry::poses() const { return state_->poses; }
 size_t Odometry::map_cells() const { return state_->map.cells(); }
 size_t Odometry::map_points() const { return state_->map.points(); }
+
+void Odometry::PredictRotationBy(Gyro gyro) { state_->gyro = std::move(gyro); }
 
 void Odometry::AddToMap(const std::vector<Eigen::Vector3d>& points_world) {
     state_->map.Add(Downsample(points_world, kMapThinning * state_->config.voxel_m));
@@ -394,16 +413,29 @@ OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& point
         guess = Eigen::Isometry3d::Identity();
         guess->linear() = ground->R_level;
     }
-    // A sweep measured while moving is deskewed at the motion model's velocity, registered,
-    // deskewed again at the velocity it was found to have, and registered once more from there.
+    // A sweep measured while moving is deskewed at the predicted motion (the motion model's
+    // velocity, or its rotation from the gyro), registered, deskewed again at the velocity it was
+    // found to have, and registered once more from there.
     const bool timed = times != nullptr && !times->empty() && std::isfinite(t);
-    double interval = 0.0;
-    const Eigen::Isometry3d delta = LastMotion(&interval);
-    std::vector<Eigen::Vector3d> frame =
-        Thinned(timed && interval > 0.0 ? Deskewed(points, *times, delta, interval) : points);
     OdometryStep step;
     step.ground = std::move(ground);
-    step.T_world_sensor = guess.value_or(Prediction(t));
+    step.T_world_sensor = guess ? *guess : Prediction(t, &step.gyro);
+    double interval = 0.0;
+    const Eigen::Isometry3d delta = LastMotion(&interval);
+    const double since = poses.empty() ? 0.0 : t - stamps.back();
+    std::vector<Eigen::Vector3d> frame;
+    if (timed && step.gyro && since > 0.0) {
+        // The predicted motion, turned as the gyro measured the sweep itself turn (from its
+        // stamp on, where the readings cover that).
+        Eigen::Isometry3d sweep = poses.back().inverse() * step.T_world_sensor;
+        if (const std::optional<Eigen::Matrix3d> R = gyro->Rotation(t, t + since)) {
+            sweep.linear() = *R;
+        }
+        frame = Thinned(Deskewed(points, *times, sweep, since));
+    } else {
+        frame =
+            Thinned(timed && interval > 0.0 ? Deskewed(points, *times, delta, interval) : points);
+    }
     if (map.empty()) {  // the first scan: the map starts in its frame
         step.points = frame.size();
         if (frame.empty()) {
@@ -419,7 +451,6 @@ OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& point
         return step;
     }
     Eigen::Isometry3d T = Align(frame, step.T_world_sensor, &step);
-    const double since = poses.empty() ? 0.0 : t - stamps.back();
     // The map as it was while the first sweep's restart (below) waits on this scan's outcome: a
     // refused scan changes nothing.
     std::optional<detail::LocalMap> before;

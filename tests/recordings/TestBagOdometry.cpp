@@ -153,32 +153,47 @@ TEST(BagOdometry, TheRecordingsImuLevelsTheMapOfASlopingStreet) {
     std::snprintf(up, sizeof(up), "%.9f,%.9f,%.9f", drive.up.x(), drive.up.y(), drive.up.z());
     const fs::path bag = WriteMovingBag(drive, "odometry_street_imu",
                                         std::string("--point-time t --tf-from 1000 --imu ") + up);
-    // Degrees between the first sweep's up in the estimated world and in the true one.
-    const auto level = [&](const std::string& options) {
+    // Degrees between the first sweep's up in the estimated world and in the true one, the
+    // trajectory's error and what the program said.
+    struct Outcome {
+        double level_deg = 0.0, ate_m = 0.0;
+        std::string out;
+    };
+    const auto run = [&](const std::string& options) {
         const fs::path out = tools::test::Temp("bag_imu_poses.txt");
         const auto r = Strata("odometry --bag " + bag.string() + " --poses-out " + out.string() +
                               " " + options);
         EXPECT_EQ(r.code, 0) << r.out;
+        const std::vector<Eigen::Isometry3d> poses = Poses(out);
         const Eigen::Vector3d estimated =
-            Poses(out).front().linear().transpose() * Eigen::Vector3d::UnitZ();
+            poses.front().linear().transpose() * Eigen::Vector3d::UnitZ();
         const Eigen::Vector3d truth = drive.starts.front().linear().transpose() * drive.up;
-        return std::make_pair(
-            std::atan2(estimated.cross(truth).norm(), estimated.dot(truth)) * 180.0 / M_PI, r.out);
+        return Outcome{
+            std::atan2(estimated.cross(truth).norm(), estimated.dot(truth)) * 180.0 / M_PI,
+            registration::AbsoluteTrajectoryRmse(poses, drive.starts), r.out};
     };
-    const auto [imu, imu_out] = level("");
-    const auto [ground, ground_out] = level("--no-imu");
-    EXPECT_NE(imu_out.find("gravity: the IMU's accelerometer (/imu/data: "), std::string::npos)
-        << imu_out;
-    EXPECT_NE(ground_out.find("no IMU (not read (--no-imu)); the first scan's ground plane"),
+    const Outcome imu = run("");
+    const Outcome ground = run("--no-imu");
+    EXPECT_NE(imu.out.find("gravity: the IMU's accelerometer (/imu/data: "), std::string::npos)
+        << imu.out;
+    EXPECT_NE(imu.out.find("prediction: rotation from the IMU's gyro ("), std::string::npos)
+        << imu.out;
+    EXPECT_NE(ground.out.find("no IMU (not read (--no-imu)); the first scan's ground plane"),
               std::string::npos)
-        << ground_out;
-    std::printf("the first sweep's up: %.4f deg off with the IMU, %.4f deg by the ground plane\n",
-                imu, ground);
-    ::testing::Test::RecordProperty("imu_level_deg", std::to_string(imu));
-    ::testing::Test::RecordProperty("ground_level_deg", std::to_string(ground));
+        << ground.out;
+    EXPECT_NE(ground.out.find("prediction: constant velocity\n"), std::string::npos) << ground.out;
+    std::printf(
+        "the first sweep's up: %.4f deg off with the IMU, %.4f deg by the ground plane; "
+        "ATE %.4f m with the gyro's prediction, %.4f m without\n",
+        imu.level_deg, ground.level_deg, imu.ate_m, ground.ate_m);
+    ::testing::Test::RecordProperty("imu_level_deg", std::to_string(imu.level_deg));
+    ::testing::Test::RecordProperty("ground_level_deg", std::to_string(ground.level_deg));
+    ::testing::Test::RecordProperty("gyro_ate_m", std::to_string(imu.ate_m));
+    ::testing::Test::RecordProperty("constant_velocity_ate_m", std::to_string(ground.ate_m));
     if (strata::testing::UnderSanitizer()) return;  // 1.5 s: too short for the figure
-    EXPECT_LT(imu, kMaxImuLevelDeg);
-    EXPECT_GT(ground, kMinGroundLevelDeg);
+    EXPECT_LT(imu.level_deg, kMaxImuLevelDeg);
+    EXPECT_GT(ground.level_deg, kMinGroundLevelDeg);
+    EXPECT_LT(imu.ate_m, kMaxBagAteM);
 }
 
 // The share of the map's occupied voxels farther than one voxel from every true point (moved

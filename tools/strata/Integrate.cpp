@@ -126,6 +126,7 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
         std::cout << "odometry: " << r.odometry->poses.size() << " scans posed, "
                   << r.odometry->length_m << " m in " << r.odometry->seconds << " s"
                   << (args.poses_out.empty() ? "" : "; poses in " + args.poses_out) << "\n"
+                  << pipeline::DescribePrediction(*r.odometry) << "\n"
                   << pipeline::DescribeGravity(*r.odometry) << "\n";
     }
     std::cout << "session " << r.session.id << " (" << r.session.name << "): " << r.session.scans

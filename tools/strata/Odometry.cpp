@@ -49,6 +49,7 @@ void Run(OdometryArgs args) {
               << source.Describe() << ", " << t.length_m << " m in " << t.seconds << " s ("
               << 1e3 * t.seconds / static_cast<double>(source.size()) << " ms a scan); poses in "
               << args.poses_out << "\n"
+              << pipeline::DescribePrediction(t) << "\n"
               << pipeline::DescribeGravity(t) << "\n";
 }
 

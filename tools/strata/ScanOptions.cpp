@@ -26,7 +26,8 @@ void AddRecordingOptions(CLI::App& cmd, pipeline::ScanSpec& spec) {
                    "is (default: the recording's one Imu topic)");
     cmd.add_flag(
         "--no-imu", [&r](int64_t) { r.imu = false; },
-        "With --odometry: do not read the recording's IMU (up from the first scan's ground)");
+        "With --odometry: do not read the recording's IMU (up from the first scan's ground, the "
+        "rotation predicted at constant velocity instead of by the gyro)");
 }
 
 void AddScanOptions(CLI::App& cmd, pipeline::ScanSpec& spec) {

@@ -42,18 +42,27 @@ struct EstimatedTrajectory {
     /// level by it (the ground plane's levelling undone).
     std::optional<registration::ImuLevel> imu;
     std::string imu_note;  ///< the recording's IMU: what was read, or why none was
+    /// Scans whose predicted rotation came from the recording's gyro (the others': the motion
+    /// model's), and why the gyro was not used when it was read but not used.
+    size_t gyro_predicted = 0;
+    std::string gyro_failure;
 };
 
 /// @brief What the program warns of after a run, a line each: the scans left out, and how many
 /// were degenerate with the first few named.
 [[nodiscard]] std::vector<std::string> OdometryWarnings(const EstimatedTrajectory& trajectory);
 
+/// @brief One line on what predicted each scan's motion: "prediction: rotation from the IMU's
+/// gyro (N of M scans), translation at constant velocity" or "prediction: constant velocity".
+[[nodiscard]] std::string DescribePrediction(const EstimatedTrajectory& trajectory);
+
 /// @brief One line on where the map's up came from, for the program's output: "gravity: the
 /// IMU's accelerometer ...", "gravity: the first scan's ground plane, ..." or "gravity: none
 /// found (...): z is the first scan's".
 [[nodiscard]] std::string DescribeGravity(const EstimatedTrajectory& trajectory);
 
-/// @brief Reads each scan of `source` and registers it; with a recording's IMU, turns the poses
+/// @brief Reads each scan of `source` and registers it; with a recording's IMU, predicts each
+/// scan's rotation by its gyro (registration::Odometry::PredictRotationBy) and turns the poses
 /// level by its accelerometer (registration::LevelFromAccelerometer).
 /// @throw RefusedError naming the scan and why ("scan 12 (<file>): too little overlap ...")
 /// when one cannot be registered and `skip_failures` is false, or when no scan was registered;
