@@ -269,11 +269,12 @@ struct Odometry::State {
         if (tb > ta) *interval = tb - ta;  // false for NaN
         return poses[poses.size() - 2].inverse() * poses.back();
     }
-    // The sensor's motion from the last pose to instant `t` (NaN: the next scan at the steady
-    // rate): the last motion's velocity, its rotation replaced by the gyro's over the span where
-    // the readings cover it (`by_gyro` then set). The identity before two poses without a gyro.
-    [[nodiscard]] Eigen::Isometry3d PredictedMotion(double t, bool* by_gyro) const {
+    // The pose at instant `t` (NaN: the next scan at the steady rate) at the last motion's
+    // velocity, its rotation replaced by the gyro's over the span where the readings cover it
+    // (`by_gyro` then set); the world's first scan before any pose.
+    [[nodiscard]] Eigen::Isometry3d Prediction(double t, bool* by_gyro) const {
         *by_gyro = false;
+        if (poses.empty()) return T_world_first.value_or(Eigen::Isometry3d::Identity());
         double interval = 0.0;
         const Eigen::Isometry3d delta = LastMotion(&interval);
         Eigen::Isometry3d motion = interval == 0.0 || !std::isfinite(t)
@@ -286,13 +287,7 @@ struct Odometry::State {
                 *by_gyro = true;
             }
         }
-        return motion;
-    }
-    // The pose at instant `t` (as PredictedMotion), where the world's first scan goes before any.
-    [[nodiscard]] Eigen::Isometry3d Prediction(double t, bool* by_gyro) const {
-        *by_gyro = false;
-        if (poses.empty()) return T_world_first.value_or(Eigen::Isometry3d::Identity());
-        return poses.back() * PredictedMotion(t, by_gyro);
+        return poses.back() * motion;
     }
     [[nodiscard]] double Sigma() const {
         return errors == 0 ? config.initial_threshold_m
