@@ -142,9 +142,21 @@ GroundLevel LevelFromGround(const std::vector<Eigen::Vector3d>& points, const Gr
     g.normal = plane.n;
     g.tilt_deg = TiltDeg(plane.n);
     g.height_m = plane.d;
-    g.R_level =
-        Eigen::Quaterniond::FromTwoVectors(plane.n, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    g.R_level = RotationOntoZ(plane.n);
     return g;
+}
+
+// By the axis and angle rather than Eigen's Quaternion::FromTwoVectors, whose singular value
+// decomposition for the opposite case was 10 s of every build's compile (docs/reliability.md,
+// "Build and CI time").
+Eigen::Matrix3d RotationOntoZ(const Eigen::Vector3d& up) {
+    const Eigen::Vector3d axis = up.cross(Eigen::Vector3d::UnitZ());
+    const double sine = axis.norm(), cosine = up.z();
+    if (sine < 1e-12) {
+        return cosine > 0.0 ? Eigen::Matrix3d::Identity()
+                            : Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    }
+    return Eigen::AngleAxisd(std::atan2(sine, cosine), axis / sine).toRotationMatrix();
 }
 
 }  // namespace strata::registration

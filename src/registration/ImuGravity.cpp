@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "strata/core/Scan.hpp"
+#include "strata/registration/Gravity.hpp"
 
 namespace strata::registration {
 namespace {
@@ -135,8 +136,7 @@ ImuLevel LevelFromAccelerometer(const Accelerometer& imu, const std::vector<doub
     const Eigen::Vector3d first_z = poses.front().linear().col(2);
     level.first_tilt_deg =
         std::atan2(first_z.cross(level.up).norm(), first_z.dot(level.up)) * 180.0 / M_PI;
-    level.R_level =
-        Eigen::Quaterniond::FromTwoVectors(level.up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    level.R_level = RotationOntoZ(level.up);
     return level;
 }
 

@@ -1,5 +1,6 @@
 #include "strata/registration/TrajectoryError.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <string>
@@ -14,6 +15,28 @@ void RequireSameSize(size_t a, size_t b) {
         throw InvalidArgumentError("trajectories of " + std::to_string(a) + " and " +
                                    std::to_string(b) + " poses cannot be compared");
     }
+}
+
+// The rotation and translation that move `ours` onto `theirs` with the least sum of squared
+// distances: Horn's closed form (J. Opt. Soc. Am. A 4(4), 1987), the rotation's unit quaternion
+// the eigenvector of the largest eigenvalue of a symmetric 4x4 matrix of the cross-covariance.
+// The fit of Eigen::umeyama without scale, whose singular value decomposition was 6 s of every
+// build's compile (docs/reliability.md, "Build and CI time").
+Eigen::Isometry3d RigidFit(const Eigen::Matrix3Xd& ours, const Eigen::Matrix3Xd& theirs) {
+    const Eigen::Vector3d mean_ours = ours.rowwise().mean(), mean_theirs = theirs.rowwise().mean();
+    const Eigen::Matrix3d S =
+        (ours.colwise() - mean_ours) * (theirs.colwise() - mean_theirs).transpose();
+    Eigen::Matrix4d N;
+    N << S(0, 0) + S(1, 1) + S(2, 2), S(1, 2) - S(2, 1), S(2, 0) - S(0, 2), S(0, 1) - S(1, 0),
+        S(1, 2) - S(2, 1), S(0, 0) - S(1, 1) - S(2, 2), S(0, 1) + S(1, 0), S(2, 0) + S(0, 2),
+        S(2, 0) - S(0, 2), S(0, 1) + S(1, 0), -S(0, 0) + S(1, 1) - S(2, 2), S(1, 2) + S(2, 1),
+        S(0, 1) - S(1, 0), S(2, 0) + S(0, 2), S(1, 2) + S(2, 1), -S(0, 0) - S(1, 1) + S(2, 2);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(N);
+    const Eigen::Vector4d q = eigen.eigenvectors().col(3);  // eigenvalues ascend
+    Eigen::Isometry3d fit = Eigen::Isometry3d::Identity();
+    fit.linear() = Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized().toRotationMatrix();
+    fit.translation() = mean_theirs - fit.linear() * mean_ours;
+    return fit;
 }
 
 }  // namespace
@@ -62,9 +85,8 @@ double AbsoluteTrajectoryRmse(const std::vector<Eigen::Isometry3d>& estimate,
         ours.col(static_cast<Eigen::Index>(i)) = estimate[i].translation();
         theirs.col(static_cast<Eigen::Index>(i)) = truth[i].translation();
     }
-    const Eigen::Matrix4d fit = Eigen::umeyama(ours, theirs, false);
-    const Eigen::Matrix3Xd moved =
-        (fit.topLeftCorner<3, 3>() * ours).colwise() + fit.topRightCorner<3, 1>();
+    const Eigen::Isometry3d fit = RigidFit(ours, theirs);
+    const Eigen::Matrix3Xd moved = (fit.linear() * ours).colwise() + fit.translation();
     return std::sqrt((moved - theirs).colwise().squaredNorm().mean());
 }
 

@@ -3,6 +3,7 @@
 // "Gravity").
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -49,6 +50,29 @@ std::vector<Eigen::Vector3d> TiltedStreet(const Eigen::Matrix3d& tilt, bool with
     std::vector<Eigen::Vector3d> sensor;
     for (const Eigen::Vector3d& p : world) sensor.push_back(tilt.transpose() * p);
     return sensor;
+}
+
+// The levelling rotation takes up to z by the smallest turn: about an axis in the x-y plane (a
+// vector along z's turn axis is left where it was), up straight down included.
+TEST(Gravity, RotationOntoZTakesUpToZByTheSmallestTurn) {
+    std::mt19937 random(3);
+    std::normal_distribution<double> n(0.0, 1.0);
+    std::vector<Eigen::Vector3d> ups = {Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ(),
+                                        Eigen::Vector3d::UnitX(), Eigen::Vector3d(0, 1e-13, 1)};
+    for (int i = 0; i < 100; ++i) ups.emplace_back(n(random), n(random), n(random));
+    for (Eigen::Vector3d up : ups) {
+        up.normalize();
+        const Eigen::Matrix3d R = RotationOntoZ(up);
+        EXPECT_LT((R * up - Eigen::Vector3d::UnitZ()).norm(), 1e-12) << up.transpose();
+        EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+        EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+        const Eigen::Vector3d axis = up.cross(Eigen::Vector3d::UnitZ());
+        if (axis.norm() > 1e-6) {
+            EXPECT_LT((R * axis - axis).norm(), 1e-12) << up.transpose();
+        }
+        const double angle = std::acos(std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0));
+        EXPECT_NEAR(angle, std::acos(std::clamp(up.z(), -1.0, 1.0)), 1e-6) << up.transpose();
+    }
 }
 
 TEST(Gravity, TheGroundPlaneOfATiltedScanLevelsIt) {

@@ -54,75 +54,46 @@ TEST(TrajectoryError, DriftOfAKnownScaleErrorAndATurn) {
     EXPECT_NEAR(RelativeDrift(moved, truth, {100.0}).translation_percent, 0.0, 1e-9);
     EXPECT_NEAR(AbsoluteTrajectoryRmse(moved, truth), 0.0, 1e-9);
     EXPECT_NEAR(AbsoluteTrajectoryRmse(longer, truth), 0.0, 1.0) << "1 % of 200 m, fitted";
+    // A path that turns and climbs, moved by a rotation about all three axes: the fit finds it.
+    std::vector<Eigen::Isometry3d> curve, curve_moved;
+    const Eigen::Isometry3d motion = Eigen::Translation3d(4, -2, 7) *
+                                     Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
+    for (int i = 0; i < 50; ++i) {
+        curve.push_back(Eigen::Isometry3d(
+            Eigen::Translation3d(20 * std::cos(0.1 * i), 20 * std::sin(0.1 * i), 0.2 * i)));
+        curve_moved.push_back(motion * curve.back());
+    }
+    EXPECT_NEAR(AbsoluteTrajectoryRmse(curve_moved, curve), 0.0, 1e-9);
     EXPECT_THROW((void)RelativeDrift(moved, {truth[0]}, {100.0}), InvalidArgumentError);
 }
 
-// The district drive as a car drives it: corners rounded over 15 m before and after the crossing
-// (the heading turning up to 7 degrees a sweep in the middle of a turn), the sensor rolling and
-// pitching up to 1.5 and 0.9 degrees on the suspension. 1000 sweeps: a kilometre, six turns left
-// and right (the small district's serpentine of streets).
-constexpr strata::test::DriveShape kCarDrive{15.0, 1.5};
-constexpr size_t kDriveSweeps = 1000;
-// Measured on 2026-12-05 (1000 sweeps, 999 m, turned through 630 degrees): t_rel 0.212 %, r_rel
-// 0.0635 deg / 100 m (lengths 50, 100, 200 m), ATE 0.300 m; the world's up (from the first
-// sweep's ground plane) against the truth's: 0.0015 deg at the first sweep, 0.0643 at worst over
-// the drive. Held at 2-3x.
-constexpr double kMaxTranslationPercent = 0.5;
-constexpr double kMaxRotationDegPer100m = 0.15;
-constexpr double kMaxAteM = 0.6;
+// The district drive as a car drives it (strata::test::kCarDrive): its first 40 sweeps register,
+// the first levelled by its ground plane to within kMaxFirstLevelDeg of the truth's up (measured
+// 0.0015 deg on 2026-12-05; held at about 3x). The whole kilometre's drift, ATE and levelling are
+// bench_odometry's (BenchOdometryCi), which registers the same 1000 sweeps for its timing: one
+// run of the drive in CI instead of two (docs/odometry.md, "Accuracy").
+constexpr size_t kFirstSweeps = 40;
 constexpr double kMaxFirstLevelDeg = 0.005;
-constexpr double kMaxLevelDeg = 0.15;
 
 double DegreesBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
 }
 
-TEST(Odometry, DriftOverAKilometreOfTurnsWithPitchAndRoll) {
-    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(
-        strata::testing::UnderSanitizer() ? 40 : kDriveSweeps, kCarDrive);
+TEST(Odometry, TheDistrictDrivesFirstSweepsRegisterFromALevelStart) {
+    const strata::test::SimulatedDrive& drive =
+        strata::test::DistrictDrive(kFirstSweeps, strata::test::kCarDrive);
     Odometry odometry;
-    std::vector<Eigen::Isometry3d> estimate;
-    double first_level = 0.0, worst_level = 0.0;
     for (size_t k = 0; k < drive.sweeps.size(); ++k) {
         const OdometryStep step = odometry.Register(drive.sweeps[k]);
         ASSERT_TRUE(step.registered) << "scan " << k << ": " << step.failure;
-        if (k == 0) {
-            ASSERT_TRUE(step.ground.has_value() && step.ground->found) << "no ground levelled";
-        }
-        estimate.push_back(step.T_world_sensor);
-        // Where each sweep's sensor sees up, in the estimated world and in the true one.
+        if (k > 0) continue;
+        ASSERT_TRUE(step.ground.has_value() && step.ground->found) << "no ground levelled";
+        // Where the sensor sees up, in the estimated world and in the true one.
         const double level =
             DegreesBetween(step.T_world_sensor.linear().transpose() * Eigen::Vector3d::UnitZ(),
                            drive.truth[k].linear().transpose() * Eigen::Vector3d::UnitZ());
-        if (k == 0) first_level = level;
-        worst_level = std::max(worst_level, level);
+        EXPECT_LT(level, kMaxFirstLevelDeg);
     }
-    const Drift d = RelativeDrift(estimate, drive.truth, {50.0, 100.0, 200.0}, 5);
-    const double ate = AbsoluteTrajectoryRmse(estimate, drive.truth);
-    double turned = 0.0;  // the heading's turns, left and right
-    for (size_t k = 1; k < drive.truth.size(); ++k) {
-        const Eigen::Vector3d a = drive.truth[k - 1].linear().col(0);
-        const Eigen::Vector3d b = drive.truth[k].linear().col(0);
-        turned += std::abs(std::remainder(std::atan2(b.y(), b.x()) - std::atan2(a.y(), a.x()),
-                                          2.0 * M_PI)) *
-                  180.0 / M_PI;
-    }
-    std::printf(
-        "%zu sweeps, %.0f m of path, turned through %.1f deg: t_rel %.3f %%, r_rel %.4f deg/100 m "
-        "(%zu segments), ATE %.3f m; level %.4f deg at the start, %.4f at worst\n",
-        drive.sweeps.size(), drive.Length(), turned, d.translation_percent, d.rotation_deg_per_100m,
-        d.segments, ate, first_level, worst_level);
-    ::testing::Test::RecordProperty("t_rel_percent", std::to_string(d.translation_percent));
-    ::testing::Test::RecordProperty("r_rel_deg_per_100m", std::to_string(d.rotation_deg_per_100m));
-    ::testing::Test::RecordProperty("ate_m", std::to_string(ate));
-    ::testing::Test::RecordProperty("level_deg", std::to_string(worst_level));
-    EXPECT_LT(first_level, kMaxFirstLevelDeg);
-    if (strata::testing::UnderSanitizer()) return;  // 40 m: too short for the 100 m figures
-    ASSERT_GT(turned, 5 * 90.0);                    // the turns were driven
-    EXPECT_LT(d.translation_percent, kMaxTranslationPercent);
-    EXPECT_LT(d.rotation_deg_per_100m, kMaxRotationDegPer100m);
-    EXPECT_LT(ate, kMaxAteM);
-    EXPECT_LT(worst_level, kMaxLevelDeg);
 }
 
 // The map the odometry's poses make, against the map of the true poses: the walls the slant
@@ -139,7 +110,8 @@ constexpr double kMaxMeanSlantDifferenceDeg = 0.35;
 constexpr double kMaxSlantDifferenceDeg = 1.2;
 
 TEST(Odometry, TheMapFromItsPosesLeansAsTheTrueMap) {
-    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(kWallSweeps, kCarDrive);
+    const strata::test::SimulatedDrive& drive =
+        strata::test::DistrictDrive(kWallSweeps, strata::test::kCarDrive);
     Odometry odometry;
     core::VoxelMap truth = core::VoxelMap::Create(kWallVoxelM);
     core::VoxelMap ours = core::VoxelMap::Create(kWallVoxelM);
@@ -281,7 +253,8 @@ TEST(Odometry, SweepsTakenWhileDrivingAreDeskewedByTheMotionModel) {
 }
 
 TEST(Odometry, AScanFromElsewhereIsRefusedAndChangesNothing) {
-    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(3, kCarDrive);
+    const strata::test::SimulatedDrive& drive =
+        strata::test::DistrictDrive(3, strata::test::kCarDrive);
     Odometry odometry;
     ASSERT_TRUE(odometry.Register(drive.sweeps[0]).registered);
     ASSERT_TRUE(odometry.Register(drive.sweeps[1]).registered);

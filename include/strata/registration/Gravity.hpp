@@ -50,4 +50,8 @@ struct GroundLevel {
 [[nodiscard]] GroundLevel LevelFromGround(const std::vector<Eigen::Vector3d>& points,
                                           const GroundConfig& config = {});
 
+/// @brief The smallest rotation that takes the unit vector `up` to z (about the axis up x z);
+/// a half turn about x when `up` points straight down.
+[[nodiscard]] Eigen::Matrix3d RotationOntoZ(const Eigen::Vector3d& up);
+
 }  // namespace strata::registration
