@@ -38,17 +38,18 @@ jobs=${STRATA_BUILD_JOBS:-$(nproc)}
 # the simulator's Embree sweeps, the change detector's parallel tile loads, the vehicle stage's
 # Embree ray checks, registration's parallel matching and the walls' stages after DBSCAN
 # (FindWalls: K-means, the part tests and the fits in parallel; WallAssembler's slotted wall:
-# one assembler's state handed to another). Reader processes against a
+# one assembler's state handed to another; the matching surface read from a map's tiles by
+# threads, MapSurface). Reader processes against a
 # writer process (StoreFaults) are left to ASan: TSan sees threads, not processes, and the store's
 # threads are the in-process reader test's. Tests of other things (most store tests take
 # minutes under TSan) run under ASan only.
 tsan_targets=(test_integration test_store test_sim test_change test_vehicles test_registration
-              test_walls test_scale)
+              test_walls)
 tsan_tests='^(Integrator|Limits|Simulator|ChangeDetection|RayCheck|ClearVehicles|FindWalls)\.'
 tsan_tests+='|^OctomapAgreement\.SeveralSynthetic|^RegistrationIcp\.Recovers'
 tsan_tests+='|^Store\.(SessionsEqualInMemory|OneWriterAtATime|ReadersSeeWholeCommits)'
 tsan_tests+='|^WallAssembler\.(AWallCutByASlot|WhatOneReleases)'
-tsan_tests+='|^TileByTile\.TheSurfaceReadAround|^SessionCloud\.'
+tsan_tests+='|^MapSurface\.|^SessionCloud\.'
 # What the TSan selection held (44 on 2026-12-02, the 3 FindWalls tests and 2 WallAssembler
 # tests since 2026-12-04, the matching surface read from a map's tiles by threads and the
 # session cloud since 2026-12-05;

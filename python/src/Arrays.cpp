@@ -105,6 +105,24 @@ std::vector<uint32_t> IdsFromArray(const py::array& ids, size_t count, const cha
     return out;
 }
 
+std::vector<float> TimesFromArray(const py::array& times, size_t count) {
+    if (times.ndim() != 1 || static_cast<size_t>(times.shape(0)) != count) {
+        throw InvalidArgumentError("times must have shape (" + std::to_string(count) +
+                                   ",), one per point; got " + ShapeText(times));
+    }
+    const auto values = py::array_t<double, py::array::forcecast>(times);  // the view's owner
+    const auto v = values.unchecked<1>();
+    std::vector<float> out(count);
+    for (size_t i = 0; i < count; ++i) {
+        const double t = v(static_cast<py::ssize_t>(i));
+        if (!std::isfinite(t)) {
+            throw InvalidArgumentError("times[" + std::to_string(i) + "] is not finite");
+        }
+        out[i] = static_cast<float>(t);
+    }
+    return out;
+}
+
 core::Scan ScanFromArrays(const py::array& points, const py::array& pose, const py::object& labels,
                           const py::object& classes, const py::object& ray_origins,
                           const py::object& ray_starts) {

@@ -27,6 +27,9 @@ namespace py = pybind11;
 /// (N,) non-negative integers of any integer dtype, N = `count`.
 [[nodiscard]] std::vector<uint32_t> IdsFromArray(const py::array& ids, size_t count,
                                                  const char* name);
+/// (N,) finite seconds, N = `count`: when each point was measured, after the
+/// sweep's `time` (core::Scan::times_s; a span over 10 s is refused where the sweep is read).
+[[nodiscard]] std::vector<float> TimesFromArray(const py::array& times, size_t count);
 
 /// A scan from arrays: `labels` are SemanticKITTI ids (class | instance << 16, as .label files
 /// and strata.simulate give them), `classes` strata's class ids (as queries give them); at most

@@ -40,6 +40,9 @@ py::dict ScanToDict(core::Scan&& scan) {
     out["ray_origins"] = std::move(origins);
     out["ray_starts"] = std::move(starts);
     out["time"] = scan.time_s;
+    // Seconds after `time` at which each point was measured: a recording's sweep read unposed.
+    out["times"] = scan.times_s.empty() ? py::object(py::none())
+                                        : py::object(ToArray(std::move(scan.times_s), {n}));
     return out;
 }
 
@@ -93,7 +96,7 @@ void RegisterReaders(py::module_& m) {
     py::class_<RecordedScans>(m, "_Recording")
         .def(py::init([](const std::string& path, const std::string& points_topic,
                          const std::string& fixed_frame, const std::string& odom_topic, bool deskew,
-                         const std::string& frames) {
+                         const std::string& frames, bool posed) {
                  RequireExists(path);
                  recordings::RecordedScanOptions options;
                  options.points_topic = points_topic;
@@ -101,11 +104,13 @@ void RegisterReaders(py::module_& m) {
                  options.odom_topic = odom_topic;
                  options.deskew = deskew;
                  options.frames = frames;
+                 options.posed = posed;
+                 options.imu = false;  // the gyro's prediction is strata odometry's (not here)
                  py::gil_scoped_release release;
                  return RecordedScans::Open(path, options);
              }),
              py::arg("path"), py::arg("points_topic"), py::arg("fixed_frame"),
-             py::arg("odom_topic"), py::arg("deskew"), py::arg("frames"))
+             py::arg("odom_topic"), py::arg("deskew"), py::arg("frames"), py::arg("posed"))
         .def("__len__", &RecordedScans::size)
         .def("scan",
              [](const RecordedScans& scans, size_t k) {

@@ -7,6 +7,7 @@
 #include "StoredMap.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/NewSession.hpp"
+#include "strata/recordings/Deskew.hpp"
 #include "strata/registration/Odometry.hpp"
 
 namespace strata::python {
@@ -36,7 +37,7 @@ public:
 
     py::dict Integrate(const py::array& points, const py::object& pose, const py::object& labels,
                        const py::object& classes, const py::object& ray_origins,
-                       const py::object& ray_starts) {
+                       const py::object& ray_starts, const py::object& times, double time) {
         pipeline::NewSession& session = Writer();
         if (odometry_.has_value() != pose.is_none()) {
             throw InvalidArgumentError(odometry_ ? "this session estimates its poses "
@@ -49,17 +50,39 @@ public:
                                           : py::array::ensure(pose);
         if (!given) throw InvalidArgumentError("pose must be a (4, 4) or (3, 4) array");
         core::Scan scan = ScanFromArrays(points, given, labels, classes, ray_origins, ray_starts);
+        scan.time_s = time;
+        if (!times.is_none()) {
+            if (!odometry_) {
+                throw InvalidArgumentError(
+                    "per-point times are for a session made with odometry=True (a posed "
+                    "recording's sweeps come deskewed already)");
+            }
+            scan.times_s = TimesFromArray(py::array::ensure(times), scan.points.size());
+            if (!stamps_.empty() && !(time > stamps_.back())) {
+                throw InvalidArgumentError(
+                    "a scan with its points' times needs its own time, after the last scan's (" +
+                    std::to_string(stamps_.back()) + " s); got " + std::to_string(time));
+            }
+        }
         integration::ScanUpdate update;
         {
             py::gil_scoped_release release;
             if (odometry_) {
-                const registration::OdometryStep step = odometry_->Register(scan.points);
+                // With its points' times, a sweep is predicted and deskewed over its instant
+                // and integrated deskewed by the motion found (docs/odometry.md).
+                const registration::OdometryStep step = scan.times_s.empty()
+                                                            ? odometry_->Register(scan.points)
+                                                            : odometry_->Register(scan);
                 if (!step.registered) {
                     throw RefusedError("scan " + std::to_string(session.scans()) +
                                        " (numpy): " + step.failure);
                 }
                 scan.T_world_sensor = step.T_world_sensor;
                 if (step.ground) ground_ = step.ground;
+                stamps_.push_back(scan.time_s);
+                if (!scan.times_s.empty()) {
+                    recordings::DeskewAlong(scan, stamps_, odometry_->poses());
+                }
             }
             update = session.Integrate(scan);
         }
@@ -123,6 +146,7 @@ private:
     std::shared_ptr<store::MapStore> store_;  // the writer refers to it: kept alive with it
     std::unique_ptr<pipeline::NewSession> session_;
     std::optional<registration::Odometry> odometry_;   // odometry=True: poses estimated
+    std::vector<double> stamps_;                       // of the poses the odometry found
     std::optional<registration::GroundLevel> ground_;  // what levelled the odometry's world
     std::optional<py::dict> committed_;
 };
@@ -135,7 +159,8 @@ void RegisterSession(py::module_& m) {
              py::arg("name"), py::arg("memory_budget_mb") = 0.0, py::arg("odometry") = false)
         .def("integrate", &Session::Integrate, py::arg("points"), py::arg("pose"),
              py::arg("labels") = py::none(), py::arg("classes") = py::none(),
-             py::arg("ray_origins") = py::none(), py::arg("ray_starts") = py::none())
+             py::arg("ray_origins") = py::none(), py::arg("ray_starts") = py::none(),
+             py::arg("times") = py::none(), py::arg("time") = 0.0)
         .def("commit", &Session::Commit)
         .def("abort", &Session::Abort)
         .def_property_readonly("record", &Session::Record)

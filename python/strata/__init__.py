@@ -23,21 +23,24 @@ __all__ = ["CLASSES", "Error", "FormatError", "InvalidArgumentError", "IoError",
 class Scan:
     """One LiDAR sweep as arrays.
 
-    points: (N, 3) sensor frame, metres; pose: (4, 4) sensor-to-map transform;
-    labels: (N,) SemanticKITTI ids (class | instance << 16) or None;
-    classes: (N,) strata class ids (index into strata.CLASSES) or None;
-    intensity: (N,) or None; time: seconds; ray_origins (R, 3) and ray_starts (R,): where the
-    rays of a deskewed sweep start (run r: points ray_starts[r] up to the next run's start, from
-    ray_origins[r] in the sensor frame), or None when every ray starts at the sensor.
+    points: (N, 3) sensor frame, metres; pose: (4, 4) sensor-to-map transform (None: a sweep
+    read unposed, for a session with odometry=True to pose); labels: (N,) SemanticKITTI ids
+    (class | instance << 16) or None; classes: (N,) strata class ids (index into strata.CLASSES)
+    or None; intensity: (N,) or None; time: seconds; ray_origins (R, 3) and ray_starts (R,):
+    where the rays of a deskewed sweep start (run r: points ray_starts[r] up to the next run's
+    start, from ray_origins[r] in the sensor frame), or None when every ray starts at the sensor;
+    times: (N,) seconds after `time` at which each point was measured (a sweep read unposed,
+    not yet deskewed) or None.
     """
     points: np.ndarray
-    pose: np.ndarray
+    pose: Optional[np.ndarray]
     labels: Optional[np.ndarray] = None
     classes: Optional[np.ndarray] = None
     intensity: Optional[np.ndarray] = None
     time: float = 0.0
     ray_origins: Optional[np.ndarray] = None
     ray_starts: Optional[np.ndarray] = None
+    times: Optional[np.ndarray] = None
 
 
 def read_points(path, bin_fields: int = 0, origin=None) -> Scan:
@@ -65,7 +68,7 @@ def read_kitti(sequence) -> dict:
 
 def read_bag(path, points_topic: Optional[str] = None, fixed_frame: Optional[str] = None,
              odom_topic: Optional[str] = None, deskew: bool = True,
-             frames: Optional[str] = None) -> Iterator[Scan]:
+             frames: Optional[str] = None, posed: bool = True) -> Iterator[Scan]:
     """Yields the sweeps of a robot recording, posed and deskewed, as `strata integrate --bag`
     reads them (docs/recordings.md): a ROS 1 .bag, an MCAP file, or a rosbag2 SQLite bag (a
     .db3 file or its folder).
@@ -79,15 +82,24 @@ def read_bag(path, points_topic: Optional[str] = None, fixed_frame: Optional[str
     refusal raised) at the call; the sweeps are read one at a time as the generator is iterated.
     To map them: `with m.session("drive") as s: for scan in strata.read_bag(p):
     s.integrate(scan)`.
+
+    posed=False reads a recording without a trajectory as `strata odometry --bag` does: /tf and
+    odom_topic are not read (only /tf_static, for the sensor's frame), each Scan comes with
+    pose None and, where the clouds carry them, its points' `times` (deskew=False: without);
+    a session made with odometry=True poses them, deskewing each sweep by the motion it finds:
+    `with m.session("drive", odometry=True) as s: for scan in strata.read_bag(p, posed=False):
+    s.integrate(scan)`. The recording's IMU is not used here (`strata odometry` predicts each
+    sweep's rotation with its gyro).
     """
     rec = _strata._Recording(str(path), points_topic or "", fixed_frame or "", odom_topic or "",
-                             deskew, frames or "")
+                             deskew, frames or "", posed)
 
     def sweeps():
         for k in range(len(rec)):
             d = rec.scan(k)
-            yield Scan(points=d["points"], pose=d["pose"], intensity=d["intensity"],
-                       time=d["time"], ray_origins=d["ray_origins"], ray_starts=d["ray_starts"])
+            yield Scan(points=d["points"], pose=d["pose"] if posed else None,
+                       intensity=d["intensity"], time=d["time"], ray_origins=d["ray_origins"],
+                       ray_starts=d["ray_starts"], times=d["times"])
     return sweeps()
 
 
@@ -120,14 +132,16 @@ class Session:
         self._impl = _strata._Session(map._impl, name, memory_budget_mb, odometry)
 
     def integrate(self, points, pose=None, labels=None, classes=None, ray_origins=None,
-                  ray_starts=None) -> dict:
+                  ray_starts=None, times=None, time: float = 0.0) -> dict:
         """Integrates one scan (see VoxelMap.integrate for the arrays, or give a strata.Scan
         alone) with the map's integration rule, through the same session writer as
         `strata integrate`; nothing reaches the map on disk before commit(). Returns
         {"points", "dropped", "clipped"}. An error about the scan names it
         ("scan 3 (numpy): ..."). In a session made with odometry=True give no pose: the
         odometry registers the points to the scans before (a Scan's pose is ignored), and a
-        scan it cannot register raises RefusedError."""
+        scan it cannot register raises RefusedError; a Scan with its points' `times` (read
+        with strata.read_bag(..., posed=False)) is predicted over its `time` and deskewed by
+        the motion found."""
         if isinstance(points, Scan):
             if pose is not None:
                 raise TypeError("integrate(scan) takes the pose from the Scan")
@@ -135,8 +149,10 @@ class Session:
             # A Scan from strata.simulate has both; the labels (with instances) are the fuller.
             classes = s.classes if s.labels is None else None
             return self._impl.integrate(s.points, None if self._odometry else s.pose, s.labels,
-                                        classes, s.ray_origins, s.ray_starts)
-        return self._impl.integrate(points, pose, labels, classes, ray_origins, ray_starts)
+                                        classes, s.ray_origins, s.ray_starts,
+                                        s.times if self._odometry else None, s.time)
+        return self._impl.integrate(points, pose, labels, classes, ray_origins, ray_starts,
+                                    times, time)
 
     @property
     def poses(self) -> Optional[np.ndarray]:

@@ -79,6 +79,36 @@ Eigen::Matrix4d AlignmentFromText(const std::string& text) {
     return m;
 }
 
+// The odometry's poses as text and back, every digit kept: each pose's scan index, instant and
+// 4x4 transform (for the other ranks, which integrate their share of the scans at them).
+std::string TrajectoryText(const EstimatedTrajectory& t) {
+    std::ostringstream os;
+    os << std::setprecision(17) << t.poses.size() << ' ';
+    for (size_t k = 0; k < t.poses.size(); ++k) {
+        os << t.scans[k] << ' ' << t.times_s[k] << ' ' << AlignmentText(t.poses[k].matrix());
+    }
+    return os.str();
+}
+
+EstimatedTrajectory TrajectoryFromText(const std::string& text) {
+    std::istringstream is(text);
+    size_t n = 0;
+    is >> n;
+    EstimatedTrajectory t;
+    for (size_t k = 0; is && k < n; ++k) {
+        size_t scan = 0;
+        double time = 0.0;
+        Eigen::Matrix4d m;
+        is >> scan >> time;
+        for (int i = 0; i < 16; ++i) is >> m.data()[i];
+        t.scans.push_back(scan);
+        t.times_s.push_back(time);
+        t.poses.emplace_back(m);
+    }
+    if (!is) throw FormatError("the odometry's poses from rank 0 are cut short");
+    return t;
+}
+
 // The session on several ranks: rank 0 opens (or creates) the map for writing and aligns the
 // session, the others open it for reading once it has; then every rank integrates its share.
 IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& request,
@@ -102,6 +132,19 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
         OnEveryRank(ranks, [&] { source.emplace(ScanSource::Open(scans, map.settings().origin)); });
         IntegrateResult result;
         result.created = created;
+        if (options.odometry) {
+            // Rank 0 estimates the poses (one scan after another, the odometry's nature) and
+            // writes them before anything reaches the map; every rank integrates at them.
+            OnEveryRank(ranks, [&] {
+                if (!ranks.root()) return;
+                result.odometry = EstimateTrajectory(*source, *options.odometry);
+                if (!options.poses_out.empty())
+                    WriteTrajectory(options.poses_out, *result.odometry);
+            });
+            const EstimatedTrajectory t = TrajectoryFromText(
+                ranks.Broadcast(ranks.root() ? TrajectoryText(*result.odometry) : std::string()));
+            source.emplace(source->Posed(t.scans, t.poses, t.times_s));
+        }
         store::SessionOptions session;
         session.name = options.name;
         session.source = source->Describe();
@@ -176,12 +219,7 @@ IntegrateResult IntegrateSession(const std::filesystem::path& dir, const ScanSpe
     if (request.georeference_from.empty() && !scans.files.empty()) {
         request.georeference_from = scans.files.front();
     }
-    if (options.ranks && options.ranks->size() > 1) {
-        if (options.odometry) {
-            throw InvalidArgumentError("--odometry runs in one process, not under mpirun");
-        }
-        return RunOnRanks(dir, request, scans, options);
-    }
+    if (options.ranks && options.ranks->size() > 1) return RunOnRanks(dir, request, scans, options);
     std::optional<OpenedMap> opened;
     opened.emplace(OpenOrCreateMap(dir, request));
     const bool created = opened->created;

@@ -96,11 +96,7 @@ core::Scan ScanSource::Read(size_t i) const {
     }
     if (posed_.empty()) return scan;
     scan.T_world_sensor = posed_.at(i);
-    const Eigen::Isometry3d T_stamp_world = scan.T_world_sensor.inverse();
-    recordings::Deskew(scan, [&](double tau) {
-        return Eigen::Isometry3d(T_stamp_world *
-                                 core::PoseAt(posed_times_s_, posed_, scan.time_s + tau));
-    });
+    recordings::DeskewAlong(scan, posed_times_s_, posed_);
     return scan;
 }
 

@@ -99,4 +99,12 @@ void Deskew(core::Scan& scan, const SweepMotion& motion) {
     scan.times_s.clear();
 }
 
+void DeskewAlong(core::Scan& scan, const std::vector<double>& times_s,
+                 const std::vector<Eigen::Isometry3d>& poses) {
+    const Eigen::Isometry3d T_stamp_world = scan.T_world_sensor.inverse();
+    Deskew(scan, [&](double tau) {
+        return Eigen::Isometry3d(T_stamp_world * core::PoseAt(times_s, poses, scan.time_s + tau));
+    });
+}
+
 }  // namespace strata::recordings

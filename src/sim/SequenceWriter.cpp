@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "strata/core/Error.hpp"
 #include "strata/io/KittiSequence.hpp"
@@ -22,6 +23,16 @@ std::string FrameName(size_t index, const char* extension) {
 void WriteText(const std::filesystem::path& path, const std::string& text) {
     std::ofstream out(path);
     out << text;
+    out.close();
+    if (!out) throw IoError("cannot write " + path.string());
+}
+
+// A sweep's points' times: float32 seconds after its stamp, one per point (the layout of
+// velodyne/NNNNNN.time that tests/recordings/write_ros1_bag.py --motion reads).
+void WriteTimes(const std::filesystem::path& path, const std::vector<float>& times) {
+    std::ofstream out(path, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(times.data()),
+              static_cast<std::streamsize>(times.size() * sizeof(float)));
     out.close();
     if (!out) throw IoError("cannot write " + path.string());
 }
@@ -50,6 +61,9 @@ void SequenceWriter::Add(const SimulatedScan& scan, const Eigen::Isometry3d& T_s
     io::WriteKittiBin(dir_ / "velodyne" / FrameName(index, ".bin"), scan.scan.points,
                       scan.scan.intensity);
     io::WriteKittiLabels(dir_ / "labels" / FrameName(index, ".label"), scan.raw_labels);
+    if (!scan.scan.times_s.empty()) {
+        WriteTimes(dir_ / "velodyne" / FrameName(index, ".time"), scan.scan.times_s);
+    }
     poses_.push_back(T_session_sensor);
     times_.push_back(scan.scan.time_s);
 }

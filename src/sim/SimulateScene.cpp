@@ -129,7 +129,14 @@ SimulatedScan SessionSimulation::Sweep(size_t k) const {
     request.seed = seed_;
     request.scan_index = (uint64_t{session_} << 32) | k;  // one noise stream per sweep
     request.time_s = pose.time_s;
-    return simulator_.SimulateSweep(request, sensor_);
+    SimulatedScan scan = simulator_.SimulateSweep(request, sensor_);
+    if (motion_) {  // each point measured at its column's instant, as a spinning sensor does
+        scan.scan.times_s.resize(scan.column.size());
+        for (size_t j = 0; j < scan.column.size(); ++j) {
+            scan.scan.times_s[j] = static_cast<float>(sensor_.ColumnTimeS(scan.column[j]));
+        }
+    }
+    return scan;
 }
 
 Eigen::Isometry3d SessionSimulation::T_session_sensor(size_t k) const {

@@ -9,7 +9,6 @@
 #include <sstream>
 #include <tuple>
 
-#include "Sanitizer.hpp"
 #include "StoreTestUtil.hpp"
 #include "strata/change/MapObserver.hpp"
 #include "strata/core/Error.hpp"
@@ -18,9 +17,7 @@
 #include "strata/pipeline/Export.hpp"
 #include "strata/pipeline/Info.hpp"
 #include "strata/registration/MapRegion.hpp"
-#include "strata/registration/MapSurface.hpp"
 #include "strata/registration/Register.hpp"
-#include "strata/registration/Surface.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -258,39 +255,6 @@ TEST(TileByTile, RegisterReadsTheWholeMapsPointsTileByTile) {
     EXPECT_EQ(a.result.iterations, b.result.iterations);
     EXPECT_EQ(a.map_points, b.map_points);
     EXPECT_TRUE(a.result.T_map_source.matrix() == b.result.T_map_source.matrix());
-}
-
-// The surface is read only around the source (registration::MapSurface, its tiles read by
-// threads: the ThreadSanitizer step runs this test), yet the alignment is the one against the
-// surface of every point of the box, bit for bit; also when any move of a point to another cell
-// reads the level again.
-TEST(TileByTile, TheSurfaceReadAroundTheSourceAlignsAsTheWholeBoxsSurface) {
-    const store::MapStore map = TwoRooms("tiles_surface");
-    const AlignmentCase c = RoomAlignment();
-    registration::RegistrationConfig config = c.options.config;
-    config.min_source_range_m = c.options.min_range_m;
-    config.max_source_range_m = c.options.max_range_m;
-    const Eigen::AlignedBox3d near =
-        registration::BoundsOf(c.cloud.points, c.guess, c.options.margin_m);
-    const registration::RegistrationResult w = registration::RegisterPoints(
-        registration::Surface::FromPoints(
-            registration::OccupiedPoints(map.LoadMap(map.Latest()), near), config.surface),
-        c.cloud.points, c.guess, config);
-    EXPECT_GT(w.iterations, 1);
-    registration::MapSurface around(map, map.Latest(), near, config.surface);
-    const registration::RegistrationResult a =
-        registration::RegisterPoints(around, c.cloud.points, c.guess, config);
-    EXPECT_TRUE(a.T_map_source.matrix() == w.T_map_source.matrix());
-    EXPECT_EQ(a.iterations, w.iterations);
-    EXPECT_GE(around.reads(), config.surface.level_cells_m.size());
-    // With no cover, every move reads again: the same calls, 70 of this test's 95 s under TSan
-    // (run for the threads of a pass), so only the normal build makes them.
-    if (strata::testing::UnderSanitizer()) return;
-    registration::MapSurface tight(map, map.Latest(), near, config.surface, /*cover_cells=*/0);
-    const registration::RegistrationResult t =
-        registration::RegisterPoints(tight, c.cloud.points, c.guess, config);
-    EXPECT_TRUE(t.T_map_source.matrix() == w.T_map_source.matrix());
-    EXPECT_GT(tight.reads(), around.reads());
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "CliTestUtil.hpp"
+#include "DriveFolder.hpp"
 #include "MapDiff.hpp"
 #include "Sanitizer.hpp"
 #include "strata/store/MapStore.hpp"
@@ -78,6 +79,33 @@ TEST(MpiCli, IntegrateOnTwoAndThreeRanksGivesTheOneProcessMap) {
     const Result info = Mpirun(2, "info " + one.string());
     EXPECT_EQ(info.code, 0) << info.out;
     EXPECT_EQ(Count(info.out, "\nsessions:\n"), 1u) << info.out;
+}
+
+// --odometry under mpirun: rank 0 estimates the poses (and writes --poses-out) before anything
+// reaches the map, every rank integrates its share at them: the map and the poses of one process.
+TEST(MpiCli, IntegrateOdometryOnRanksGivesTheOneProcessMapAndPoses) {
+    const fs::path seq = WriteDriveFolder("mpi_odometry_seq", 12);
+    const std::string flags = " --kitti " + seq.string() + " --voxel 0.2 --odometry --poses-out ";
+    const fs::path one = Temp("mpi_odometry_one"), one_poses = Temp("mpi_odometry_one.txt");
+    const Result single = Strata("integrate " + one.string() + flags + one_poses.string());
+    ASSERT_EQ(single.code, 0) << single.out;
+    for (int ranks : RankCounts()) {
+        const fs::path many = Temp("mpi_odometry_many_" + std::to_string(ranks));
+        const fs::path poses = Temp("mpi_odometry_many_" + std::to_string(ranks) + ".txt");
+        const Result r = Mpirun(ranks, "integrate " + many.string() + flags + poses.string());
+        ASSERT_EQ(r.code, 0) << r.out;
+        EXPECT_EQ(Count(r.out, "odometry: 12 scans posed"), 1u) << r.out;  // rank 0 reports
+        EXPECT_EQ(ReadText(poses), ReadText(one_poses)) << ranks << " ranks";
+        ExpectSameStores(many, one);
+    }
+    // A scan the odometry cannot register stops every rank, and nothing is left behind.
+    const fs::path bad = WriteDriveFolder("mpi_odometry_elsewhere", 5, 3);
+    const fs::path refused = Temp("mpi_odometry_refused");
+    const Result r = Mpirun(RankCounts().back(), "integrate " + refused.string() + " --kitti " +
+                                                     bad.string() + " --voxel 0.2 --odometry");
+    EXPECT_NE(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("scan 3 ("), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(refused));
 }
 
 TEST(MpiCli, WallsOnTwoAndThreeRanksAreTheOneProcessWalls) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "CliTestUtil.hpp"
+#include "DriveFolder.hpp"
 #include "SimulatedDrive.hpp"
 
 namespace strata::tools::test {
@@ -18,22 +19,9 @@ constexpr size_t kSweeps = 30;  // 29 m of the first street
 // prediction). Held at about 2x.
 constexpr double kMaxPositionErrorM = 0.25;
 
-// The first kSweeps sweeps of the drive as velodyne/NNNNNN.bin, no poses; `elsewhere`: that
-// sweep's points moved 300 m away.
+// The drive's first kSweeps sweeps, no poses; `elsewhere`: that sweep moved 300 m away.
 fs::path WriteDrive(const std::string& name, size_t elsewhere = SIZE_MAX) {
-    const strata::test::SimulatedDrive& drive = strata::test::DistrictDrive(kSweeps);
-    const fs::path dir = strata::test::TempPath(name);
-    fs::create_directories(dir / "velodyne");
-    for (size_t k = 0; k < drive.sweeps.size(); ++k) {
-        std::vector<Eigen::Vector3d> points = drive.sweeps[k];
-        if (k == elsewhere) {
-            for (Eigen::Vector3d& p : points) p.x() += 300.0;
-        }
-        char file[32];
-        std::snprintf(file, sizeof(file), "%06zu.bin", k);
-        io::WriteKittiBin(dir / "velodyne" / file, points);
-    }
-    return dir;
+    return WriteDriveFolder(name, kSweeps, elsewhere);
 }
 
 TEST(OdometryCli, AFolderWithoutPosesComesBackAsTheDrive) {

@@ -112,7 +112,8 @@ void RegisterSimulate(CLI::App& app) {
     cmd->add_option("--noise", args->noise, "Range noise standard deviation in metres")
         ->capture_default_str();
     cmd->add_flag("--motion", args->config.motion,
-                  "Move the sensor during each sweep (raw points, not deskewed)");
+                  "Move the sensor during each sweep (raw points, not deskewed; each point's "
+                  "time in velodyne/NNNNNN.time)");
     cmd->add_option("--surface-spacing", args->config.surface_spacing_m,
                     "Spacing of the ground-truth static surface sample (m)")
         ->capture_default_str();

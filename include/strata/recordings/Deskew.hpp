@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <functional>
+#include <vector>
 
 #include "strata/core/Scan.hpp"
 
@@ -25,5 +26,11 @@ void RequireSweepTimes(const core::Scan& scan);
 /// is emptied. A scan without times is left as it is.
 /// @throw RequireSweepTimes's; whatever `motion` throws (a time outside a known trajectory).
 void Deskew(core::Scan& scan, const SweepMotion& motion);
+
+/// @brief Deskew with the motion of a trajectory (`poses` at increasing instants `times_s`, the
+/// odometry's), interpolated between its poses and extrapolated past its ends, relative to
+/// `scan.T_world_sensor`, the sweep's pose at its stamp (`scan.time_s`) on that trajectory.
+void DeskewAlong(core::Scan& scan, const std::vector<double>& times_s,
+                 const std::vector<Eigen::Isometry3d>& poses);
 
 }  // namespace strata::recordings
