@@ -3,6 +3,8 @@
 // that every benchmark times the same thing (integration, not file reading) and reads the data
 // through strata::io exactly as the tools do.
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
@@ -50,6 +52,18 @@ inline int ExitStatus(const char* program, bool missed, const std::filesystem::p
 /// Seconds elapsed since `start`.
 inline double Seconds(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// CPU seconds this process has used (all its threads): what a ratio between two runs of one
+/// thread should compare on a shared machine, whose other processes lengthen the wall time of
+/// either run at random but not its CPU time (cold CI runs on the AMD EPYC kind saw a hundred
+/// odometry sweeps at 1.9x the wall time of the others, and `integrate --bag` at 1.51x
+/// `--kitti` from the fastest of five alternated runs where the same build gives 1.01-1.07x
+/// alone, 2026-12-06).
+inline double CpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 /// The first `max_scans` scans of a KITTI-layout sequence: points in the sensor frame, with

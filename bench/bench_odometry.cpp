@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <vector>
 
@@ -49,15 +48,6 @@ constexpr double kMaxRotationDegPer100m = 0.15;
 constexpr double kMaxAteM = 0.6;
 constexpr double kMaxLevelDeg = 0.15;
 
-// CPU seconds this process has used: a sweep's cost on its one thread, which other processes on
-// a shared machine do not lengthen as they do its wall time (a cold CI run saw one hundred of
-// sweeps take 1.9x the wall time of the others with the local map no larger, 2026-12-06).
-double CpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 // CPU milliseconds each sweep took to register; `cells` and `poses`, when given, the local map's
 // cells and the sweep's estimated pose after it.
 // With `drive`, its sweeps' points' times and stamps go with them (sweeps measured in motion,
@@ -75,10 +65,10 @@ std::vector<double> Run(const std::vector<std::vector<Eigen::Vector3d>>& sweeps,
             scan.times_s = drive->times[k];
             scan.time_s = drive->stamps[k];
         }
-        const double start = CpuSeconds();
+        const double start = bench::CpuSeconds();
         const registration::OdometryStep step =
             drive != nullptr ? odometry.Register(scan) : odometry.Register(sweeps[k]);
-        ms.push_back(1e3 * (CpuSeconds() - start));
+        ms.push_back(1e3 * (bench::CpuSeconds() - start));
         if (cells != nullptr) cells->push_back(odometry.map_cells());
         if (poses != nullptr) poses->push_back(step.T_world_sensor);
         if (!step.registered)
