@@ -71,10 +71,16 @@ std::string AlignmentText(const Eigen::Matrix4d& m) {
     return os.str();
 }
 
-Eigen::Matrix4d AlignmentFromText(const std::string& text) {
-    std::istringstream is(text);
+// The next 16 numbers of `is` as AlignmentText wrote them (`is` fails when they are not there).
+Eigen::Matrix4d ReadMatrix(std::istream& is) {
     Eigen::Matrix4d m;
     for (int i = 0; i < 16; ++i) is >> m.data()[i];
+    return m;
+}
+
+Eigen::Matrix4d AlignmentFromText(const std::string& text) {
+    std::istringstream is(text);
+    const Eigen::Matrix4d m = ReadMatrix(is);
     if (!is) throw FormatError("the session's alignment from rank 0 is not 16 numbers");
     return m;
 }
@@ -98,12 +104,10 @@ EstimatedTrajectory TrajectoryFromText(const std::string& text) {
     for (size_t k = 0; is && k < n; ++k) {
         size_t scan = 0;
         double time = 0.0;
-        Eigen::Matrix4d m;
         is >> scan >> time;
-        for (int i = 0; i < 16; ++i) is >> m.data()[i];
         t.scans.push_back(scan);
         t.times_s.push_back(time);
-        t.poses.emplace_back(m);
+        t.poses.emplace_back(ReadMatrix(is));
     }
     if (!is) throw FormatError("the odometry's poses from rank 0 are cut short");
     return t;
