@@ -1,7 +1,5 @@
 #include "StoreSessions.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -14,12 +12,6 @@
 #include "strata/store/SessionWriter.hpp"
 
 namespace strata::bench {
-
-double CpuSeconds() {
-    timespec ts{};
-    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 double Mb(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
 

@@ -12,9 +12,6 @@
 
 namespace strata::bench {
 
-/// CPU seconds this process has used so far (all threads).
-[[nodiscard]] double CpuSeconds();
-
 /// Bytes as MB (1e6), for the tables.
 [[nodiscard]] double Mb(uint64_t bytes);
 

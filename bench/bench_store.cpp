@@ -18,7 +18,6 @@
 // are written to a fresh directory under the system temporary directory (fsync'd as in real use)
 // and removed at the end.
 #include <tbb/global_control.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
