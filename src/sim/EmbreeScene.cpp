@@ -74,12 +74,23 @@ float EmbreeScene::ClosestDistance(const Eigen::Vector3f& point, float max_radiu
 EmbreeScene::EmbreeScene(const std::vector<Mesh>& meshes) {
     device_ = rtcNewDevice("verbose=0");
     if (device_ == nullptr) ThrowEmbree(rtcGetDeviceError(nullptr), "cannot create a device");
+    // Built once and queried many times: spend the build time on a better BVH.
+    Build(meshes, RTC_BUILD_QUALITY_HIGH);
+}
+
+EmbreeScene::EmbreeScene(const EmbreeScene& device_owner, const std::vector<Mesh>& meshes)
+    : device_(device_owner.device_) {
+    rtcRetainDevice(device_);
+    // Built for one sweep of rays over a few thousand triangles: the build time counts.
+    Build(meshes, RTC_BUILD_QUALITY_LOW);
+}
+
+void EmbreeScene::Build(const std::vector<Mesh>& meshes, RTCBuildQuality quality) {
     scene_ = rtcNewScene(device_);
     if (scene_ == nullptr) {
         Fail("cannot create a scene");
     }
-    // Built once and queried many times: spend the build time on a better BVH.
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(scene_, quality);
     for (size_t i = 0; i < meshes.size(); ++i) {
         const Mesh& m = meshes[i];
         if (m.triangles.empty()) continue;
@@ -98,7 +109,7 @@ EmbreeScene::EmbreeScene(const std::vector<Mesh>& meshes) {
             std::memcpy(v + 3 * k, m.vertices[k].data(), 3 * sizeof(float));
         }
         std::memcpy(t, m.triangles.data(), m.triangles.size() * 3 * sizeof(uint32_t));
-        rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
+        rtcSetGeometryBuildQuality(geom, quality);
         rtcCommitGeometry(geom);
         rtcAttachGeometryByID(scene_, geom, static_cast<unsigned>(i));
         rtcReleaseGeometry(geom);  // the scene holds its own reference
@@ -164,6 +175,13 @@ bool EmbreeScene::Intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f
 
 void EmbreeScene::Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3f* direction,
                              int count, float t_far, Hit* hits) const {
+    float far[8];
+    std::fill(far, far + 8, t_far);
+    Intersect8(origin, direction, count, far, hits);
+}
+
+void EmbreeScene::Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3f* direction,
+                             int count, const float* t_far, Hit* hits) const {
     alignas(32) int valid[8];
     alignas(32) RTCRayHit8 rh;
     for (int i = 0; i < 8; ++i) {
@@ -177,7 +195,7 @@ void EmbreeScene::Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3
         rh.ray.dir_y[i] = d.y();
         rh.ray.dir_z[i] = d.z();
         rh.ray.tnear[i] = 0.0F;
-        rh.ray.tfar[i] = t_far;
+        rh.ray.tfar[i] = t_far[on ? i : 0];  // an unused lane is masked off anyway
         rh.ray.time[i] = 0.0F;
         rh.ray.mask[i] = 0xFFFFFFFFU;
         rh.ray.id[i] = static_cast<unsigned>(i);

@@ -11,11 +11,16 @@
 
 namespace strata::sim {
 
-/// Move-only owner of an Embree device and a committed scene. Geometry id = mesh index.
-/// Ray queries on the committed scene are thread-safe (Embree documentation).
+/// Move-only owner of a committed Embree scene and a reference to its device. Geometry id =
+/// mesh index (empty meshes are left out). Ray queries on the committed scene are thread-safe
+/// (Embree documentation).
 class EmbreeScene {
 public:
+    /// A scene on a device of its own, built for many rays (high build quality).
     explicit EmbreeScene(const std::vector<Mesh>& meshes);
+    /// A scene on the device of `device_owner` (shared, reference counted, so either may go
+    /// first), built fast rather than for many rays: the few actors placed anew for each sweep.
+    EmbreeScene(const EmbreeScene& device_owner, const std::vector<Mesh>& meshes);
     ~EmbreeScene();
     EmbreeScene(EmbreeScene&& other) noexcept;
     EmbreeScene& operator=(EmbreeScene&& other) noexcept;
@@ -36,12 +41,17 @@ public:
     /// for a miss.
     void Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3f* direction, int count,
                     float t_far, Hit* hits) const;
+    /// The same with a far limit per ray (`t_far[i]` for i < count), e.g. the hit of another
+    /// scene, so that only nearer surfaces are reported.
+    void Intersect8(const Eigen::Vector3f& origin, const Eigen::Vector3f* direction, int count,
+                    const float* t_far, Hit* hits) const;
 
     /// Distance from `point` to the nearest triangle, searched within `max_radius`; infinity
     /// when none is that near (Embree point query, exact closest point on each triangle).
     [[nodiscard]] float ClosestDistance(const Eigen::Vector3f& point, float max_radius) const;
 
 private:
+    void Build(const std::vector<Mesh>& meshes, RTCBuildQuality quality);
     [[noreturn]] void Fail(const std::string& what);  // releases, then throws strata::Error
     void Release() noexcept;
 

@@ -123,6 +123,17 @@ void WriteGroundTruth(const std::filesystem::path& path, const GroundTruth& trut
         j["gaps"].push_back(
             {{"name", g.name}, {"kind", g.kind}, {"polygon", to.Polygon(g.polygon)}});
     }
+    j["actors"] = json::array();
+    for (const ActorTruth& a : truth.actors) {
+        j["actors"].push_back({{"id", a.id},
+                               {"name", a.name},
+                               {"type", a.type},
+                               {"moving", json::array({a.start_s, a.end_s})},
+                               {"before", a.before},
+                               {"after", a.after},
+                               {"speed_mps", a.speed_mps},
+                               {"path", to.Polygon(a.path)}});
+    }
     j["static_surface"] = truth.static_surface;
     std::ofstream out(path);
     out << j.dump(1) << "\n";

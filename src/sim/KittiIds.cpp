@@ -17,12 +17,14 @@ struct ClassEntry {
 
 // Names as in the SemanticKITTI label definition; colours are our own, chosen so that classes
 // that share a strata class (road, sidewalk, parking, markings) stay apart in a picture.
-constexpr std::array<ClassEntry, 19> kEntries = {{
+constexpr std::array<ClassEntry, 25> kEntries = {{
     {kUnlabeled, "unlabeled", {0, 0, 0}},
     {kCar, "car", {40, 90, 230}},
     {kBus, "bus", {20, 50, 170}},
     {kTruck, "truck", {70, 40, 180}},
     {kOtherVehicle, "other-vehicle", {90, 140, 255}},
+    {kPerson, "person", {255, 40, 200}},
+    {kBicyclist, "bicyclist", {200, 40, 255}},
     {kRoad, "road", {90, 90, 95}},
     {kParking, "parking", {130, 110, 140}},
     {kSidewalk, "sidewalk", {175, 170, 165}},
@@ -37,6 +39,10 @@ constexpr std::array<ClassEntry, 19> kEntries = {{
     {kPole, "pole", {250, 230, 100}},
     {kTrafficSign, "traffic-sign", {230, 30, 30}},
     {kOtherObject, "other-object", {0, 200, 200}},
+    {kMovingCar, "moving-car", {255, 215, 0}},
+    {kMovingBicyclist, "moving-bicyclist", {255, 120, 0}},
+    {kMovingPerson, "moving-person", {255, 60, 60}},
+    {kMovingTruck, "moving-truck", {230, 170, 0}},
 }};
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "strata/sim/GroundTruth.hpp"
 #include "strata/sim/ObjectSpec.hpp"
 #include "strata/sim/Scene.hpp"
+#include "strata/sim/Traffic.hpp"
 
 namespace strata::sim::detail {
 
@@ -19,6 +20,9 @@ namespace strata::sim::detail {
 [[nodiscard]] std::vector<Mesh> BuildPlantMeshes(const ObjectSpec& object, const PlantSpec& plant,
                                                  uint64_t scene_seed);
 [[nodiscard]] std::vector<Mesh> BuildPropMeshes(const ObjectSpec& object);  // box, pole, stairs
+/// One mesh of a traffic actor in its own frame (origin on the ground under the middle of its
+/// footprint, x forward), labelled with its moving class and its id; not static.
+[[nodiscard]] Mesh BuildActorMesh(const ActorSpec& actor);
 
 /// Height of a slab's top surface at (x, y) (the slope applied), ignoring its extent.
 [[nodiscard]] double SlabTopZ(const SlabSpec& slab, double x, double y);

@@ -61,6 +61,12 @@ Scene BuildScene(const SceneSpec& spec, size_t session) {
         }
         truth.floors.push_back(f);
     }
+    // Traffic: traced by the simulator at each sweep's time, reported apart from the vehicles.
+    scene.actors = ss.traffic;
+    for (const ActorSpec& a : ss.traffic) {
+        truth.actors.push_back(
+            {a.id, a.name, a.type, a.start_s, a.EndS(), a.before, a.after, a.speed_mps, a.path});
+    }
     for (const GapSpec& g : spec.gaps) {
         const Eigen::Vector2d a = g.box.min(), b = g.box.max();
         truth.gaps.push_back(

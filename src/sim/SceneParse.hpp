@@ -3,6 +3,7 @@
 // Scene-file parsing internals (private): object parsers and generators share one assembler
 // that hands out ids in file order, so ids are stable for a given file.
 #include <string>
+#include <vector>
 
 #include "JsonReader.hpp"
 #include "strata/sim/SceneSpec.hpp"
@@ -45,6 +46,8 @@ void GenerateBuilding(JsonReader& r, SceneAssembler& a);
 void GenerateDistrict(JsonReader& r, SceneAssembler& a);
 
 [[nodiscard]] TrajectorySpec ParseTrajectory(JsonReader& r);
+/// A session's "traffic" list: actors with ids from the assembler, path z on the ground.
+[[nodiscard]] std::vector<ActorSpec> ParseTraffic(JsonReader& r, SceneAssembler& a);
 [[nodiscard]] SessionSpec ParseSession(JsonReader& r, const TrajectorySpec& fallback,
                                        SceneAssembler& a);
 

@@ -126,6 +126,15 @@ Picture RenderScenePicture(const Scene& scene, const Simulator& simulator,
             canvas.Box(e.box, e.change == "added" ? core::Rgb{0, 255, 0} : core::Rgb{255, 0, 0});
         }
     }
+    if (config.draw_traffic) {
+        for (const ActorSpec& a : scene.actors) {
+            const core::Rgb c = kitti::Color(ActorLabel(a.type, true));
+            for (size_t i = 1; i < a.path.size(); ++i) {
+                canvas.Line(a.path[i - 1].head<2>(), a.path[i].head<2>(), c);
+            }
+            canvas.Dot(a.path.front().head<2>(), 1, c);
+        }
+    }
     if (config.draw_trajectory) {
         for (const ScanPose& pose : poses) {
             canvas.Dot(pose.T_world_sensor.translation().head<2>(), 2, {255, 30, 30});

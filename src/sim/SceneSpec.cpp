@@ -154,6 +154,22 @@ void SceneSpec::Validate() const {
                               "' has no trajectory waypoints");
         }
         (void)ObjectsOfSession(*this, s);  // throws on an edit of an unknown object
+        std::set<std::string> actor_names;
+        for (const ActorSpec& a : sessions[s].traffic) {
+            const std::string at = source + ": session '" + sessions[s].name + "': ";
+            if (!ids.insert(a.id).second) {
+                throw FormatError(at + "actor '" + a.name + "' has the id of another object (" +
+                                  std::to_string(a.id) + ")");
+            }
+            if (!actor_names.insert(a.name).second) {
+                throw FormatError(at + "duplicate actor name '" + a.name + "'");
+            }
+            try {
+                a.Validate();
+            } catch (const InvalidArgumentError& e) {
+                throw FormatError(at + e.what());
+            }
+        }
     }
 }
 

@@ -109,6 +109,7 @@ SessionSpec ParseSession(JsonReader& r, const TrajectorySpec& fallback, SceneAss
         s.edits.push_back(ParseEdit(item, a));
         item.Finish();
     }
+    s.traffic = ParseTraffic(r, a);
     return s;
 }
 

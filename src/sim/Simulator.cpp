@@ -1,6 +1,7 @@
 #include "strata/sim/Simulator.hpp"
 
 #include "EmbreeScene.hpp"
+#include "ObjectGeometry.hpp"
 #include "strata/sim/KittiIds.hpp"
 
 namespace strata::sim {
@@ -12,6 +13,14 @@ Simulator::Simulator(const Scene& scene) : embree_(std::make_unique<EmbreeScene>
         labels_.push_back(m.label);
         instances_.push_back(m.instance);
         reflectivity_.push_back(m.reflectivity);
+    }
+    actors_ = scene.actors;
+    for (const ActorSpec& a : actors_) {
+        a.Validate();
+        actor_meshes_.push_back(detail::BuildActorMesh(a));
+        const uint16_t standing = ActorLabel(a.type, false), moving = ActorLabel(a.type, true);
+        actor_labels_.push_back({standing, moving});
+        actor_classes_.push_back({mapping.Map(standing), mapping.Map(moving)});
     }
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "ActorScene.hpp"
 #include "EmbreeScene.hpp"
 #include "Rng.hpp"
 #include "strata/core/Labels.hpp"
@@ -49,11 +50,13 @@ Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3
     return T;
 }
 
-// What every column of one sweep shares: the scene, the sensor, its beams' elevations and the
-// key of the sweep's random draws.
+// What every column of one sweep shares: the scene and the actors placed at the sweep's time,
+// the sensor, its beams' elevations and the key of the sweep's random draws.
 struct SweepContext {
     const EmbreeScene& embree;
     const std::vector<float>& reflectivity;  // per mesh
+    const EmbreeScene* actors = nullptr;     // none when no actor is present
+    std::vector<float> actor_reflectivity;   // per actor
     const SensorModel& sensor;
     std::vector<float> cos_el, sin_el;  // per beam
     uint64_t key;
@@ -74,6 +77,26 @@ Eigen::Isometry3d ColumnPose(const SweepRequest& request, const SensorModel& sen
     if (!request.T_world_sensor_end) return request.T_world_sensor;
     return Interpolate(request.T_world_sensor, *request.T_world_sensor_end,
                        sensor.ColumnTimeS(col) * sensor.rate_hz);
+}
+
+// Replaces each static hit (or miss) by an actor's surface nearer along the same ray, its
+// geometry numbered after the static meshes (SimulatedScan::mesh).
+void TakeNearerActors(const SweepContext& ctx, const Eigen::Vector3f& origin,
+                      const Eigen::Vector3f* dir, size_t count, EmbreeScene::Hit* hits) {
+    float t_far[8];
+    EmbreeScene::Hit nearer[8];
+    for (size_t i = 0; i < count; ++i) {
+        t_far[i] = hits[i].geometry == RTC_INVALID_GEOMETRY_ID
+                       ? static_cast<float>(ctx.sensor.max_range_m)
+                       : hits[i].t;
+    }
+    ctx.actors->Intersect8(origin, dir, static_cast<int>(count), t_far, nearer);
+    const auto statics = static_cast<uint32_t>(ctx.reflectivity.size());
+    for (size_t i = 0; i < count; ++i) {
+        if (nearer[i].geometry == RTC_INVALID_GEOMETRY_ID) continue;
+        hits[i] = nearer[i];
+        hits[i].geometry += statics;
+    }
 }
 
 // Traces every beam of column c and appends its returns (dropout, grazing cut, range noise and
@@ -99,6 +122,7 @@ void TraceColumn(const SweepContext& ctx, const Eigen::Isometry3d& T, size_t c,
         }
         ctx.embree.Intersect8(origin, dir, static_cast<int>(count),
                               static_cast<float>(sensor.max_range_m), hits);
+        if (ctx.actors != nullptr) TakeNearerActors(ctx, origin, dir, count, hits);
         for (size_t i = 0; i < count; ++i) {
             const EmbreeScene::Hit& hit = hits[i];
             if (hit.geometry == RTC_INVALID_GEOMETRY_ID) continue;
@@ -112,8 +136,11 @@ void TraceColumn(const SweepContext& ctx, const Eigen::Isometry3d& T, size_t c,
             const double range = hit.t + sensor.range_noise_m * noise.x();
             if (range < sensor.min_range_m || range > sensor.max_range_m) continue;
             // Lambertian return: albedo times the cosine of the incidence angle.
-            const double intensity =
-                ctx.reflectivity[hit.geometry] * cos_inc + sensor.intensity_noise * noise.y();
+            const float albedo =
+                hit.geometry < ctx.reflectivity.size()
+                    ? ctx.reflectivity[hit.geometry]
+                    : ctx.actor_reflectivity[hit.geometry - ctx.reflectivity.size()];
+            const double intensity = albedo * cos_inc + sensor.intensity_noise * noise.y();
             out.push_back({dir_sensor[i] * static_cast<float>(range),
                            static_cast<float>(std::clamp(intensity, 0.0, 1.0)), hit.geometry,
                            static_cast<uint16_t>(b0 + i), static_cast<uint16_t>(c)});
@@ -126,8 +153,15 @@ void TraceColumn(const SweepContext& ctx, const Eigen::Isometry3d& T, size_t c,
 SimulatedScan Simulator::SimulateSweep(const SweepRequest& request,
                                        const SensorModel& sensor) const {
     sensor.Validate();
-    const SweepContext ctx(*embree_, reflectivity_, sensor,
-                           detail::HashKey(request.seed, request.scan_index, 0x5CA7));
+    SweepContext ctx(*embree_, reflectivity_, sensor,
+                     detail::HashKey(request.seed, request.scan_index, 0x5CA7));
+    // docs/simulator.md, "Traffic": the actors stand where they are at the sweep's start.
+    const detail::PlacedActors placed =
+        detail::PlaceActors(*embree_, actors_, actor_meshes_, request.time_s);
+    if (placed.scene) {
+        ctx.actors = &*placed.scene;
+        for (const ActorSpec& a : actors_) ctx.actor_reflectivity.push_back(a.reflectivity);
+    }
     const size_t beams = sensor.beams();
     const auto columns = static_cast<size_t>(sensor.columns);
     // Chunks of columns, each with its own small buffer of returns (reused from the allocator's
@@ -161,11 +195,22 @@ SimulatedScan Simulator::SimulateSweep(const SweepRequest& request,
     result.mesh.reserve(valid);
     for (const auto& chunk : chunks) {
         for (const RaySample& s : chunk) {
-            const uint16_t label = labels_[s.mesh];
-            const uint16_t instance = instances_[s.mesh];
+            uint16_t label = 0, instance = 0;
+            core::SemanticClass semantic_class = core::SemanticClass::kUnknown;
+            if (s.mesh < labels_.size()) {
+                label = labels_[s.mesh];
+                instance = instances_[s.mesh];
+                semantic_class = classes_[s.mesh];
+            } else {  // an actor: moving or standing at the sweep's time
+                const size_t a = s.mesh - labels_.size();
+                const size_t moving = placed.moving[a];
+                label = actor_labels_[a][moving];
+                instance = static_cast<uint16_t>(actors_[a].id);
+                semantic_class = actor_classes_[a][moving];
+            }
             scan.points.push_back(s.point_sensor.cast<double>());
             scan.intensity.push_back(s.intensity);
-            scan.labels.push_back(classes_[s.mesh]);
+            scan.labels.push_back(semantic_class);
             scan.instances.push_back(instance);
             result.raw_labels.push_back(uint32_t(label) | (uint32_t(instance) << 16));
             result.beam.push_back(s.beam);

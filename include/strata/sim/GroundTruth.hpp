@@ -56,6 +56,19 @@ struct GapTruth {
     std::vector<Eigen::Vector3d> polygon;
 };
 
+/// @brief A traffic actor (ActorSpec): what it is and when it moves, in session time.
+struct ActorTruth {
+    int id = 0;  ///< instance id of its points
+    std::string name;
+    std::string type;      ///< car, suv, van, truck, person, cyclist
+    double start_s = 0.0;  ///< it moves during [start_s, end_s]
+    double end_s = 0.0;
+    bool before = false;  ///< stands at the path's start before start_s
+    bool after = false;   ///< stands at the path's end after end_s
+    double speed_mps = 0.0;
+    std::vector<Eigen::Vector3d> path;
+};
+
 /// @brief Everything ground_truth.json holds for one session. Coordinates are in the world
 /// frame inside the library; WriteGroundTruth expresses them in the session frame.
 struct GroundTruth {
@@ -68,6 +81,7 @@ struct GroundTruth {
     std::vector<FloorTruth> floors;
     std::vector<EditTruth> edits;
     std::vector<GapTruth> gaps;
+    std::vector<ActorTruth> actors;  ///< traffic; not in `vehicles`, not in the static surface
     std::string static_surface = "static_surface.ply";
     std::string sensor;
     uint64_t seed = 0;           ///< noise seed of the sensor model

@@ -14,6 +14,8 @@ inline constexpr uint16_t kCar = 10;
 inline constexpr uint16_t kBus = 13;
 inline constexpr uint16_t kTruck = 18;
 inline constexpr uint16_t kOtherVehicle = 20;
+inline constexpr uint16_t kPerson = 30;
+inline constexpr uint16_t kBicyclist = 31;
 inline constexpr uint16_t kRoad = 40;
 inline constexpr uint16_t kParking = 44;
 inline constexpr uint16_t kSidewalk = 48;
@@ -28,6 +30,11 @@ inline constexpr uint16_t kTerrain = 72;
 inline constexpr uint16_t kPole = 80;
 inline constexpr uint16_t kTrafficSign = 81;
 inline constexpr uint16_t kOtherObject = 99;
+// Moving things (traffic): SemanticKITTI's moving classes.
+inline constexpr uint16_t kMovingCar = 252;
+inline constexpr uint16_t kMovingBicyclist = 253;
+inline constexpr uint16_t kMovingPerson = 254;
+inline constexpr uint16_t kMovingTruck = 258;
 
 /// @brief Raw id of a SemanticKITTI class name ("car", "road", "other-structure", ...) or of a
 /// decimal id given as text ("44"); throws InvalidArgumentError for anything else.

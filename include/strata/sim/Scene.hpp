@@ -30,7 +30,9 @@ struct Mesh {
 
 /// @brief A scene ready to ray trace: the meshes of one session and its ground truth.
 struct Scene {
-    std::vector<Mesh> meshes;
+    std::vector<Mesh> meshes;  ///< the static scene (vehicles included), traced as it is
+    /// The session's traffic: not in `meshes`; Simulator places it at each sweep's time.
+    std::vector<ActorSpec> actors;
     GroundTruth truth;  ///< world frame
     Eigen::AlignedBox3d bounds;
 

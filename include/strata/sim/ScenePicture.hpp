@@ -20,6 +20,7 @@ struct PictureConfig {
     int max_size_px = 4000;       ///< larger scenes get coarser pixels
     bool draw_trajectory = true;  ///< scan positions as red dots
     bool draw_edits = true;       ///< edit boxes: added green, removed red
+    bool draw_traffic = true;  ///< actor paths in their moving class's colour, a dot at the start
 
     /// @brief Throws InvalidArgumentError for a non-positive pixel size, margin < 0 or
     /// max_size_px < 16.

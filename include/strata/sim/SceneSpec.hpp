@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "strata/sim/ObjectSpec.hpp"
+#include "strata/sim/Traffic.hpp"
 
 namespace strata::sim {
 
@@ -48,6 +49,7 @@ struct SessionSpec {
     Eigen::Isometry3d T_world_session = Eigen::Isometry3d::Identity();
     TrajectorySpec trajectory;
     std::vector<EditSpec> edits;
+    std::vector<ActorSpec> traffic;  ///< things moving during the session (docs: "Traffic")
 };
 
 /// @brief A real gap in the ground (drain, ramp edge): reported so that refill can be checked.
@@ -70,8 +72,9 @@ struct SceneSpec {
     std::vector<double> floor_z;        ///< building scenes: z offset of each storey
     std::vector<GapSpec> gaps;
 
-    /// @brief Throws FormatError (naming `source`) on duplicate ids or names, an edit
-    /// of an unknown object, or a session without waypoints.
+    /// @brief Throws FormatError (naming `source`) on duplicate ids or names (an actor's id
+    /// among the objects' ids, its name within its session), an edit of an unknown object, a
+    /// session without waypoints or a bad actor (ActorSpec::Validate).
     void Validate() const;
     /// @brief Index of the object with this name; throws FormatError if there is none.
     [[nodiscard]] size_t IndexOf(const std::string& object_name) const;

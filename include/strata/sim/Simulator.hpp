@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -42,15 +43,20 @@ struct SimulatedScan {
     std::vector<uint32_t> raw_labels;  ///< SemanticKITTI: class | instance << 16
     std::vector<uint16_t> beam;        ///< beam index (row of the beam table) per point
     std::vector<uint16_t> column;      ///< firing column per point
-    std::vector<uint32_t> mesh;        ///< index into Scene::meshes of the surface hit
-    size_t rays = 0;                   ///< rays cast (beams x columns)
+    /// Index into Scene::meshes of the surface hit; an actor a of Scene::actors is
+    /// Scene::meshes.size() + a.
+    std::vector<uint32_t> mesh;
+    size_t rays = 0;  ///< rays cast (beams x columns)
 };
 
-/// @brief Ray traces scenes with Embree. The scene is built and committed once in the
-/// constructor; all const methods are thread-safe and may run concurrently.
+/// @brief Ray traces scenes with Embree. The static scene is built and committed once in the
+/// constructor; a sweep also sees the scene's actors where they are at its time (a small scene
+/// built per sweep on the same device). All const methods are thread-safe and may run
+/// concurrently.
 class Simulator {
 public:
-    /// @brief Copies the meshes into an Embree scene; throws strata::Error if Embree fails.
+    /// @brief Copies the meshes into an Embree scene and builds the actors' meshes; throws
+    /// InvalidArgumentError for a bad actor (ActorSpec::Validate), strata::Error if Embree fails.
     explicit Simulator(const Scene& scene);
     ~Simulator();
     Simulator(Simulator&&) noexcept;
@@ -58,13 +64,17 @@ public:
     Simulator(const Simulator&) = delete;
     Simulator& operator=(const Simulator&) = delete;
 
-    /// @brief A sweep from a fixed pose. Deterministic for (pose, sensor, seed); parallel (TBB).
+    /// @brief A sweep from a fixed pose at time 0. Deterministic for (pose, sensor, seed);
+    /// parallel (TBB).
     [[nodiscard]] SimulatedScan SimulateScan(const Eigen::Isometry3d& T_world_sensor,
                                              const SensorModel& sensor, uint64_t seed) const;
-    /// @brief A sweep, optionally with motion (see SweepRequest). Validates the sensor.
+    /// @brief A sweep, optionally with motion (see SweepRequest). Validates the sensor. Actors
+    /// stand where they are at `request.time_s` for the whole sweep (docs/simulator.md,
+    /// "Traffic"); a point on one carries its moving or standing class and its id.
     [[nodiscard]] SimulatedScan SimulateSweep(const SweepRequest& request,
                                               const SensorModel& sensor) const;
-    /// @brief Closest hit of one noise-free ray (world frame) within max_range_m.
+    /// @brief Closest hit of one noise-free ray (world frame) within max_range_m; the static
+    /// scene only (as GroundHeight).
     [[nodiscard]] std::optional<RayHit> CastRay(const Eigen::Vector3d& origin,
                                                 const Eigen::Vector3d& direction,
                                                 double max_range_m) const;
@@ -78,6 +88,11 @@ private:
     std::vector<uint16_t> labels_;
     std::vector<uint16_t> instances_;
     std::vector<float> reflectivity_;
+    // Traffic: the actors, their meshes in their own frame, class ids [standing, moving].
+    std::vector<ActorSpec> actors_;
+    std::vector<Mesh> actor_meshes_;
+    std::vector<std::array<uint16_t, 2>> actor_labels_;
+    std::vector<std::array<core::SemanticClass, 2>> actor_classes_;
 };
 
 }  // namespace strata::sim
