@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "strata/core/Error.hpp"
 #include "strata/sim/KittiIds.hpp"
@@ -133,6 +134,18 @@ Picture RenderScenePicture(const Scene& scene, const Simulator& simulator,
                 canvas.Line(a.path[i - 1].head<2>(), a.path[i].head<2>(), c);
             }
             canvas.Dot(a.path.front().head<2>(), 1, c);
+            // Where it stands: boxed in its standing class's colour.
+            const core::Rgb standing = kitti::Color(ActorLabel(a.type, false));
+            for (const auto& [stands, t_s] :
+                 {std::pair{a.before, a.start_s}, std::pair{a.after, a.EndS()}}) {
+                if (!stands) continue;
+                const Eigen::Isometry3d T = ActorPoseAt(a, t_s).value().T_world_actor;
+                BoxTruth box;
+                box.center = T.translation();
+                box.size = ActorSize(a.type);
+                box.yaw_deg = std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI;
+                canvas.Box(box, standing);
+            }
         }
     }
     if (config.draw_trajectory) {

@@ -311,4 +311,52 @@ TEST(Traffic, TheSequenceCarriesTheActorsLabelsAndGroundTruth) {
     std::filesystem::remove_all(dir);
 }
 
+// datasets/scenes/traffic.json holds what docs/simulator.md says: cars both ways at 5-15 m/s,
+// people walking and crossing, a cyclist, a car that parks and one that leaves mid-session; its
+// sweeps (SessionSimulation, as `strata simulate` takes them) carry both kinds of labels.
+TEST(Traffic, TheExampleStreetHasItsTrafficInItsSweeps) {
+    const SceneSpec spec = LoadSceneSpec(test::ExampleScene("traffic"));
+    ASSERT_EQ(spec.sessions.size(), 1U);
+    const SessionSpec& session = spec.sessions[0];
+    const double end_s = (session.trajectory.max_scans - 1) * session.trajectory.every / 10.0;
+    int east = 0, west = 0, people = 0, crossing = 0, cyclists = 0, parks = 0, leaves = 0;
+    for (const ActorSpec& a : session.traffic) {
+        const Eigen::Vector3d way = a.path.back() - a.path.front();
+        if (a.type == "person") {
+            ++people;
+            crossing += std::abs(way.y()) > std::abs(way.x()) ? 1 : 0;
+        } else if (a.type == "cyclist") {
+            ++cyclists;
+        } else if (a.after) {
+            parks += a.EndS() > 0.0 && a.EndS() < end_s ? 1 : 0;
+        } else if (a.before) {
+            leaves += a.start_s > 0.0 && a.start_s < end_s ? 1 : 0;
+        } else {
+            EXPECT_GE(a.speed_mps, 5.0) << a.name;
+            EXPECT_LE(a.speed_mps, 15.0) << a.name;
+            (way.x() > 0 ? east : west) += 1;
+        }
+    }
+    EXPECT_GE(east + west, 4);
+    EXPECT_GE(east, 1);
+    EXPECT_GE(west, 1);
+    EXPECT_EQ(people, 6);
+    EXPECT_EQ(crossing, 2);
+    EXPECT_EQ(cyclists, 1);
+    EXPECT_EQ(parks, 1);
+    EXPECT_EQ(leaves, 1);
+    SimulateConfig config;
+    config.sensor = "vlp16";
+    const SessionSimulation run(spec, 0, config);
+    ASSERT_EQ(run.size(), 50U);
+    std::set<uint16_t> seen;
+    for (const size_t k : {0U, 30U, 40U}) {
+        for (const uint32_t raw : run.Sweep(k).raw_labels) seen.insert(raw & 0xFFFF);
+    }
+    for (const uint16_t label : {kitti::kMovingCar, kitti::kMovingTruck, kitti::kMovingPerson,
+                                 kitti::kCar, kitti::kPerson}) {
+        EXPECT_EQ(seen.count(label), 1U) << label;
+    }
+}
+
 }  // namespace strata::sim::traffic_tests
