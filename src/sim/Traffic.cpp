@@ -38,7 +38,7 @@ void ActorSpec::Validate() const {
     } catch (const InvalidArgumentError& e) {
         throw InvalidArgumentError(at + e.what());
     }
-    if (path.size() < 2 || !(LengthM() > 0.0)) {
+    if (path.size() < 2 || !(LengthM() > 0.0) || !std::isfinite(LengthM())) {
         throw InvalidArgumentError(at + "path needs two points or more and a length > 0");
     }
     for (const Eigen::Vector3d& p : path) {

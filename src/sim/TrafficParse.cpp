@@ -1,4 +1,5 @@
 // A session's "traffic" list (docs/simulator.md, "Traffic").
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -8,8 +9,12 @@
 namespace strata::sim::detail {
 namespace {
 
-// Path points are sampled this far apart to find where the ground steps (kerbs).
+// Path points are sampled this far apart to find where the ground steps (kerbs), and at most
+// this many times per segment (a segment over 1 km is sampled more sparsely).
 constexpr double kGroundSampleM = 0.25;
+constexpr double kMaxGroundSamples = 4096;
+// Coordinates (m) and times (s) beyond this are typos, not scenes.
+constexpr double kFarthest = 1e6;
 // A sample whose ground leaves the line through its neighbours by more than this is kept.
 constexpr double kGroundKinkM = 0.01;
 
@@ -34,8 +39,8 @@ std::vector<Eigen::Vector3d> OnTheGround(const std::vector<Eigen::Vector3d>& way
         const Eigen::Vector3d here = std::isnan(w.z()) ? ground(w.head<2>()) : w;
         if (i > 0 && std::isnan(w.z()) && std::isnan(waypoints[i - 1].z())) {
             const Eigen::Vector2d from = waypoints[i - 1].head<2>(), to = w.head<2>();
-            const int n =
-                std::max(1, static_cast<int>(std::ceil((to - from).norm() / kGroundSampleM)));
+            const double steps = std::ceil((to - from).norm() / kGroundSampleM);
+            const int n = static_cast<int>(std::clamp(steps, 1.0, kMaxGroundSamples));
             std::vector<Eigen::Vector3d> samples;
             for (int k = 0; k <= n; ++k) {
                 samples.push_back(ground(from + (to - from) * (static_cast<double>(k) / n)));
@@ -62,7 +67,11 @@ ActorSpec ParseActor(JsonReader& r, SceneAssembler& a) {
     std::vector<Eigen::Vector3d> waypoints;
     for (const auto& p : r.Require<std::vector<std::vector<double>>>("path")) {
         if (p.size() < 2 || p.size() > 3) r.Fail("'path' points are [x, y] or [x, y, z]");
-        waypoints.emplace_back(p[0], p[1], p.size() == 3 ? p[2] : std::nan(""));
+        waypoints.emplace_back(p[0], p[1], p.size() == 3 ? p[2] : 0.0);
+        if (!(waypoints.back().cwiseAbs().maxCoeff() <= kFarthest)) {
+            r.Fail("'path' coordinates must be within 1e6 m");
+        }
+        if (p.size() == 2) waypoints.back().z() = std::nan("");
     }
     if (waypoints.size() < 2) r.Fail("'path' needs two points or more");
     actor.path = OnTheGround(waypoints, a);
@@ -71,7 +80,9 @@ ActorSpec ParseActor(JsonReader& r, SceneAssembler& a) {
         r.Fail("'speed_mps' must be in (0, 100] m/s");
     }
     actor.start_s = r.Get<double>("start_s", 0.0);
-    if (!(actor.start_s >= 0.0 && std::isfinite(actor.start_s))) r.Fail("'start_s' must be >= 0");
+    if (!(actor.start_s >= 0.0 && actor.start_s <= kFarthest)) {
+        r.Fail("'start_s' must be in [0, 1e6] s");
+    }
     actor.before = r.Get<bool>("before", false);
     actor.after = r.Get<bool>("after", false);
     actor.reflectivity = r.Get<float>("reflectivity", actor.reflectivity);
