@@ -187,7 +187,7 @@ std::vector<std::string> BenchMigration(const std::vector<core::Scan>& scans, si
     const Clock::time_point start = Clock::now();
     const MapStore map = MapStore::Open(dir, MapStore::Access::kWrite);  // migrates
     const double seconds = Seconds(start);
-    bool same = map.settings().format_version == 5;
+    bool same = map.settings().format_version == store::MapStore::kFormatVersion;
     for (size_t s = 0; s < sessions && same; ++s) {
         same = testing::MapDifference(map.LoadMap(map.AsOf(static_cast<int64_t>(s + 1))), after[s])
                    .empty();

@@ -29,6 +29,10 @@ void IntegrationConfig::Validate() const {
     Require(std::isfinite(label_vote_weight) && label_vote_weight > 0.0f,
             "label_vote_weight must be positive");
     Require(max_update_bytes > 0, "max_update_bytes must be positive");
+    Require(std::isfinite(crossed_margin_m) && crossed_margin_m >= 0.0,
+            "crossed_margin_m must be >= 0");
+    Require(crossed_margin_fraction >= 0.0 && crossed_margin_fraction <= 1.0,
+            "crossed_margin_fraction must be in [0, 1]");
 }
 
 }  // namespace strata::integration

@@ -83,6 +83,7 @@ ScanUpdate RaysFrom(const std::vector<Eigen::Vector3d>& points_map, const Eigen:
     scratch.seconds.mark += SecondsSince(prepared_at);
     update.free = masks.free;
     update.occupied = masks.occupied;
+    update.crossed = masks.crossed;
     update.points = points_map.size();
     update.dropped = prepared.dropped;
     update.clipped = prepared.clipped;
@@ -110,12 +111,17 @@ ScanUpdate RaysFromEachOrigin(const core::Scan& scan,
                                          voxel_size, config, scratch);
         all.free->topologyUnion(*part.free);
         all.occupied->topologyUnion(*part.occupied);
+        if (part.crossed) {
+            if (!all.crossed) all.crossed = std::make_shared<openvdb::MaskTree>();
+            all.crossed->topologyUnion(*part.crossed);
+        }
         all.endpoints.insert(all.endpoints.end(), part.endpoints.begin(), part.endpoints.end());
         all.points += part.points;
         all.dropped += part.dropped;
         all.clipped += part.clipped;
     }
     all.free->topologyDifference(*all.occupied);
+    if (all.crossed) all.crossed->topologyDifference(*all.occupied);
     // Coordinates compare as the box index orders them (x, then y, then z).
     const auto key = [](const EndpointGroup& g) { return std::make_pair(g.ijk, g.label); };
     std::stable_sort(

@@ -83,12 +83,18 @@ void ClearColumn(const VoxelBox& box, uint64_t* bits, int64_t bx, int64_t by) {
     }
 }
 
-ScanMasks MarkDense(const PreparedScan& scan, bool wide, Bitmaps& bitmaps) {
+// Whether a prepared ray was walked: its last voxels may lie behind the surface it hit (by the
+// range noise), or, clipped at the maximum range, behind the surface it was going to hit.
+bool IsRay(const PreparedScan& scan, size_t i) { return scan.kinds[i] != PointKind::kDropped; }
+
+ScanMasks MarkDense(const PreparedScan& scan, bool wide, const NearEndMargin& margin,
+                    Bitmaps& bitmaps) {
     const VoxelBox& box = scan.box;
     const auto n_words = static_cast<size_t>(box.size() / 64);
     if (!bitmaps.clean) bitmaps.ClearAll();
     bitmaps.clean = false;
     for (Bitmap& b : bitmaps.free) b.used = false;
+    for (Bitmap& b : bitmaps.near_end) b.used = false;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
                           Bitmap& mine = bitmaps.free.local();
@@ -102,6 +108,16 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide, Bitmaps& bitmaps) {
                           } else {
                               TraceRays(scan, range, mark, bits);
                           }
+                          if (margin.metres <= 0.0) return;
+                          Bitmap& near = bitmaps.near_end.local();
+                          near.used = true;
+                          uint64_t* const near_bits = near.Zeroed(n_words);
+                          for (size_t i = range.begin(); i != range.end(); ++i) {
+                              if (!IsRay(scan, i)) continue;
+                              WalkNearEnd(scan, i, margin, [near_bits](int64_t pos) {
+                                  near_bits[pos >> 6] |= uint64_t{1} << (pos & 63);
+                              });
+                          }
                       });
     uint64_t* const occupied_words = bitmaps.occupied.Zeroed(n_words);
     for (const int64_t pos : scan.endpoint_pos) {
@@ -111,20 +127,27 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide, Bitmaps& bitmaps) {
 
     // Bricks to leaves, parallel over x-slabs of bricks; free minus occupied (occupied wins).
     // Each column of bricks is cleared once read: the bitmaps are zero again for the next scan.
-    std::vector<const uint8_t*> locals;
+    std::vector<const uint8_t*> locals, near_locals;
     std::vector<uint64_t*> all_words = {occupied_words};
     for (Bitmap& b : bitmaps.free) {
         if (!b.used) continue;  // a thread that walked no ray of this scan: all zero
         locals.push_back(reinterpret_cast<const uint8_t*>(b.words.data()));
         all_words.push_back(b.words.data());
     }
+    for (Bitmap& b : bitmaps.near_end) {
+        if (!b.used) continue;
+        near_locals.push_back(reinterpret_cast<const uint8_t*>(b.words.data()));
+        all_words.push_back(b.words.data());
+    }
+    const bool crossed = margin.metres > 0.0;
     const std::vector<const uint64_t*> read_words(all_words.begin(), all_words.end());
     // Each thread fills its own trees; merging them afterwards only moves nodes.
-    tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees, occ_trees;
+    tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees, occ_trees, crossed_trees;
     tbb::parallel_for(tbb::blocked_range<int64_t>(0, box.nx / 8), [&](const auto& range) {
         openvdb::MaskTree& my_free = free_trees.local();
         openvdb::MaskTree& my_occ = occ_trees.local();
-        uint64_t occ[8], fre[8], tmp[8];
+        openvdb::MaskTree& my_crossed = crossed_trees.local();
+        uint64_t occ[8], fre[8], tmp[8], cro[8];
         std::vector<uint64_t> acc;
         std::vector<uint8_t> any;
         for (int64_t bx = range.begin() * 8; bx != range.end() * 8; bx += 8) {
@@ -156,6 +179,17 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide, Bitmaps& bitmaps) {
                     };
                     if (any_free) emit(fre, my_free);
                     if (any_occ) emit(occ, my_occ);
+                    if (crossed && any_free) {
+                        // Free and outside every hit ray's margin.
+                        std::memcpy(cro, fre, sizeof(cro));
+                        for (const uint8_t* local : near_locals) {
+                            GatherBrick(box, local, bx, by, bz, tmp);
+                            for (int w = 0; w < 8; ++w) cro[w] &= ~tmp[w];
+                        }
+                        uint64_t any_crossed = 0;
+                        for (int w = 0; w < 8; ++w) any_crossed |= cro[w];
+                        if (any_crossed) emit(cro, my_crossed);
+                    }
                 }
                 for (uint64_t* bits : all_words) ClearColumn(box, bits, bx, by);
             }
@@ -165,11 +199,15 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide, Bitmaps& bitmaps) {
     ScanMasks masks;
     for (auto& tree : free_trees) masks.free->merge(tree, openvdb::MERGE_NODES);
     for (auto& tree : occ_trees) masks.occupied->merge(tree, openvdb::MERGE_NODES);
+    if (crossed) {
+        masks.crossed = std::make_shared<openvdb::MaskTree>();
+        for (auto& tree : crossed_trees) masks.crossed->merge(tree, openvdb::MERGE_NODES);
+    }
     return masks;
 }
 
 // Bounded-memory path for scans whose box is too large for a bitmap.
-ScanMasks MarkSparse(const PreparedScan& scan) {
+ScanMasks MarkSparse(const PreparedScan& scan, const NearEndMargin& margin) {
     const VoxelBox& box = scan.box;
     tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
@@ -184,6 +222,17 @@ ScanMasks MarkSparse(const PreparedScan& scan) {
     openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(*masks.occupied);
     for (const int64_t pos : scan.endpoint_pos) acc.setValueOn(box.CoordOf(pos));
     masks.free->topologyDifference(*masks.occupied);
+    if (margin.metres > 0.0) {
+        openvdb::MaskTree near;
+        openvdb::tree::ValueAccessor<openvdb::MaskTree> near_acc(near);
+        for (size_t i = 0; i < RayCount(scan); ++i) {
+            if (!IsRay(scan, i)) continue;
+            WalkNearEnd(scan, i, margin,
+                        [&](int64_t pos) { near_acc.setValueOn(box.CoordOf(pos)); });
+        }
+        masks.crossed = std::make_shared<openvdb::MaskTree>(*masks.free);
+        masks.crossed->topologyDifference(near);
+    }
     return masks;
 }
 
@@ -246,12 +295,13 @@ void RequireSparseMarkingFits(const PreparedScan& scan, const IntegrationConfig&
 }
 
 ScanMasks MarkScan(const PreparedScan& scan, const IntegrationConfig& config, Bitmaps& bitmaps) {
+    const NearEndMargin margin{config.crossed_margin_m, config.crossed_margin_fraction};
     if (static_cast<uint64_t>(scan.box.size() / 8) <= config.dense_scratch_limit_bytes) {
-        return MarkDense(scan, config.wide_walk && WideWalkAvailable(), bitmaps);
+        return MarkDense(scan, config.wide_walk && WideWalkAvailable(), margin, bitmaps);
     }
     // Only a scan too large for the dense scratch can be too large for memory.
     RequireSparseMarkingFits(scan, config);
-    return MarkSparse(scan);
+    return MarkSparse(scan, margin);
 }
 
 }  // namespace strata::integration::detail

@@ -31,16 +31,19 @@ struct Bitmap {
     }
 };
 
-/// The marking's bitmaps: one per thread that walks rays, one for the endpoints.
+/// The marking's bitmaps: one per thread that walks rays, one for the endpoints, and one per
+/// thread for the voxels near the rays' ends (when the crossed space is asked for).
 struct Bitmaps {
     tbb::enumerable_thread_specific<Bitmap> free;
     Bitmap occupied;
+    tbb::enumerable_thread_specific<Bitmap> near_end;
     /// False while a marking runs: one that threw may have left bits set, which the next one
     /// clears whole.
     bool clean = true;
 
     void ClearAll() {
         for (Bitmap& b : free) std::fill(b.words.begin(), b.words.end(), 0);
+        for (Bitmap& b : near_end) std::fill(b.words.begin(), b.words.end(), 0);
         std::fill(occupied.words.begin(), occupied.words.end(), 0);
         clean = true;
     }

@@ -11,7 +11,7 @@ namespace strata::integration {
 namespace {
 
 using MaskLeaf = openvdb::MaskTree::LeafNodeType;
-constexpr uint32_t kMagic = 0x31555453;  // "STU1": strata update, version 1
+constexpr uint32_t kMagic = 0x32555453;  // "STU2": strata update, version 2 (the crossed space)
 constexpr size_t kMaskWords = MaskLeaf::NodeMaskType::WORD_COUNT;
 // A leaf's record: its origin (three int32) and its mask words, packed.
 constexpr size_t kLeafBytes = 3 * sizeof(int32_t) + kMaskWords * sizeof(uint64_t);
@@ -136,7 +136,8 @@ private:
 }  // namespace
 
 bool AllLeaves(const ScanUpdate& update, const LeafFilter& keep) {
-    for (const auto* tree : {update.free.get(), update.occupied.get()}) {
+    for (const auto* tree : {update.free.get(), update.occupied.get(), update.crossed.get()}) {
+        if (!tree) continue;
         for (auto leaf = tree->cbeginLeaf(); leaf; ++leaf) {
             if (!keep(leaf->origin())) return false;
         }
@@ -154,6 +155,7 @@ ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep) {
     ScanUpdate part;
     part.free = SelectLeaves(*update.free, keep);
     part.occupied = SelectLeaves(*update.occupied, keep);
+    if (update.crossed) part.crossed = SelectLeaves(*update.crossed, keep);
     // Groups come sorted by voxel, so the voxels of one leaf mostly follow each other.
     openvdb::Coord last(std::numeric_limits<int32_t>::max());
     bool kept = false;
@@ -172,8 +174,9 @@ ScanUpdate SelectUpdate(const ScanUpdate& update, const LeafFilter& keep) {
 }
 
 std::string EncodeUpdate(const ScanUpdate& update, const LeafFilter& keep) {
-    const size_t leaves = update.free->leafCount() + update.occupied->leafCount();
-    UpdateWriter w(sizeof(kMagic) + 5 * sizeof(uint64_t) + leaves * kLeafBytes +
+    const size_t leaves = update.free->leafCount() + update.occupied->leafCount() +
+                          (update.crossed ? update.crossed->leafCount() : 0);
+    UpdateWriter w(sizeof(kMagic) + 6 * sizeof(uint64_t) + leaves * kLeafBytes +
                    update.endpoints.size() * kGroupBytes);
     w.Put(kMagic);
     w.Put(static_cast<uint64_t>(update.points));
@@ -181,6 +184,8 @@ std::string EncodeUpdate(const ScanUpdate& update, const LeafFilter& keep) {
     w.Put(static_cast<uint64_t>(update.clipped));
     w.PutTree(*update.free, keep);
     w.PutTree(*update.occupied, keep);
+    w.Put(static_cast<uint8_t>(update.crossed ? 1 : 0));
+    if (update.crossed) w.PutTree(*update.crossed, keep);
     const size_t count_at = w.PutCount();
     uint64_t count = 0;
     // Groups come sorted by voxel, so the voxels of one leaf mostly follow each other.
@@ -218,6 +223,9 @@ ScanUpdate DecodeUpdate(std::string_view bytes, const std::string& what) {
     update.clipped = static_cast<size_t>(r.Get<uint64_t>());
     update.free = r.GetTree();
     update.occupied = r.GetTree();
+    const auto has_crossed = r.Get<uint8_t>();
+    if (has_crossed > 1) r.Fail("a bad flag");
+    if (has_crossed == 1) update.crossed = r.GetTree();
     const size_t groups = r.Count(kGroupBytes);
     update.endpoints.resize(groups);
     for (EndpointGroup& g : update.endpoints) {

@@ -51,8 +51,7 @@ void SplitTile(const std::vector<TileVersion>& versions,
         const CommitInfo& commit = commits.at(v.commit);
         openvdb::GridPtrVec fused, layers, products;
         for (const auto& grid : grids) {
-            const auto [session, occupied] = ParseLayerName(grid->getName());
-            (void)occupied;
+            const int64_t session = ParseLayerName(grid->getName()).first;
             if (session != 0) {
                 // A session's layers are carried unchanged by later versions: take them from
                 // the version its own commit wrote.

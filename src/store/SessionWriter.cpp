@@ -1,6 +1,5 @@
 #include "strata/store/SessionWriter.hpp"
 
-#include <openvdb/tools/Prune.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
@@ -13,11 +12,11 @@
 #include "Catalog.hpp"
 #include "IntegrationRule.hpp"
 #include "MapStoreImpl.hpp"
+#include "SessionGrids.hpp"
 #include "TileFile.hpp"
 #include "TileSplit.hpp"
 #include "strata/core/Elapsed.hpp"
 #include "strata/core/Error.hpp"
-#include "strata/core/OccupancyMasks.hpp"
 #include "strata/core/ParallelFor.hpp"
 #include "strata/integration/UpdateParts.hpp"
 
@@ -25,20 +24,7 @@ namespace strata::store {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A session's own log-odds over one tile -> its two layers (occupied: > 0, free: <= 0), built
-// leaf by leaf: a layer voxel is true and active, or false and inactive.
-openvdb::GridPtrVec LayerGrids(int64_t session, const openvdb::FloatGrid& logodds) {
-    core::OccupancyMasks masks = core::SplitOccupancy(logodds);
-    masks.occupied->setName(detail::LayerName(session, true));
-    masks.free->setName(detail::LayerName(session, false));
-    for (auto* grid : {masks.occupied.get(), masks.free.get()}) {
-        grid->setGridClass(openvdb::GRID_UNKNOWN);
-        grid->insertMeta("units",
-                         openvdb::StringMetadata("seen by session " + std::to_string(session)));
-    }
-    return {masks.occupied, masks.free};
-}
+using detail::SessionGrids;
 
 }  // namespace
 
@@ -48,7 +34,7 @@ struct SessionWriter::State {
         uint64_t last_use = 0;
     };
     // What an eviction wrote before the commit: the tile's pending fused version, this session's
-    // layers so far, and its own log-odds, needed if a later scan touches the tile again.
+    // layers so far, and its own grids, needed if a later scan touches the tile again.
     struct Pending {
         TileVersion version;
         LayerFile layer;
@@ -63,7 +49,7 @@ struct SessionWriter::State {
     std::map<TileKey, TileVersion> committed;
     std::map<TileKey, int64_t> last_versions;
     core::VoxelMap work;
-    openvdb::FloatGrid::Ptr session;  // this session's log-odds, every resident tile
+    SessionGrids session;  // this session's own grids, every resident tile
     std::map<TileKey, Resident> resident;
     std::map<TileKey, Pending> pending;
     std::set<std::string> written_files;  // removed again unless the commit lands
@@ -109,7 +95,7 @@ struct SessionWriter::State {
             if (r.dirty) dirty.insert(key);
         }
         auto fused = detail::StealMapTiles(work, settings(), &dirty);
-        auto logodds = detail::StealTiles(*session, settings(), &dirty);
+        auto own = session.StealTiles(settings(), dirty);
         const std::vector<TileKey> keys(dirty.begin(), dirty.end());
         for (const TileKey& key : keys) {
             written_files.insert(detail::FusedFileName(key, NextVersion(key)));
@@ -117,7 +103,7 @@ struct SessionWriter::State {
         }
         std::vector<std::pair<TileVersion, LayerFile>> files(keys.size());
         core::ParallelFor(keys.size(), [&](size_t i) {
-            files[i] = WriteTile(keys[i], fused.at(keys[i]), *logodds.at(keys[i]));
+            files[i] = WriteTile(keys[i], fused.at(keys[i]), own.at(keys[i]));
         });
         for (const auto& [v, l] : files) Written(v, l);
         for (const auto& [key, p] : pending) {
@@ -145,12 +131,12 @@ struct SessionWriter::State {
         for (const auto& [key, p] : pending) impl.RemoveFiles({p.logodds.file});
     }
 
-    // What makes `key` resident: the pending version and the session's log-odds when an
-    // eviction wrote them, else the committed version, else nothing (a new tile).
+    // What makes `key` resident: the pending version and the session's grids when an eviction
+    // wrote them, else the committed version, else nothing (a new tile).
     struct Loaded {
         TileKey key;
         std::optional<core::VoxelMap> fused;
-        openvdb::FloatGrid::Ptr logodds;
+        std::optional<SessionGrids> own;
     };
 
     Loaded Read(const TileKey& key) const {
@@ -162,9 +148,7 @@ struct SessionWriter::State {
             const auto grids = detail::DecodeGrids(
                 detail::ReadVerifiedFile(impl.dir, lo, detail::FileKind::kLayers), key,
                 impl.dir / lo.file);
-            out.logodds =
-                grids.empty() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(grids[0]);
-            if (!out.logodds) throw FormatError((impl.dir / lo.file).string() + ": no log-odds");
+            out.own = SessionGrids::FromGrids(grids, (impl.dir / lo.file).string());
         } else if (const auto c = committed.find(key); c != committed.end()) {
             out.fused = store.ReadFused(c->second);
         }
@@ -183,19 +167,19 @@ struct SessionWriter::State {
             if (!l.fused) continue;
             ++stats.tiles_loaded;
             detail::MergeMap(work, *l.fused);
-            if (l.logodds) detail::MergeLeaves(*session, *l.logodds);
+            if (l.own) session.Merge(*l.own);
         }
     }
 
     [[nodiscard]] size_t MemoryBytes() const {
-        size_t bytes = session->memUsage();
+        size_t bytes = session.MemUsage();
         for (const auto& grid : work.Grids()) bytes += grid->memUsage();
         return bytes;
     }
 
     // Writes a tile leaving memory: its next fused version and this session's layers.
     std::pair<TileVersion, LayerFile> WriteTile(const TileKey& key, const core::VoxelMap& fused,
-                                                const openvdb::FloatGrid& logodds) const {
+                                                const SessionGrids& own) const {
         TileVersion v;
         v.key = key;
         v.version = NextVersion(key);
@@ -204,10 +188,10 @@ struct SessionWriter::State {
         LayerFile l;
         l.key = key;
         l.session = session_id;
-        if (logodds.activeVoxelCount() > 0) {
+        if (!own.empty()) {
             static_cast<FileRef&>(l) =
                 detail::WriteGrids(impl.dir, detail::LayerFileName(key, session_id),
-                                   LayerGrids(session_id, logodds), key);
+                                   detail::LayerGrids(session_id, own), key);
         }
         return {v, l};
     }
@@ -258,16 +242,16 @@ struct SessionWriter::State {
         }
         if (victims.empty()) return;
         auto fused = detail::StealMapTiles(work, settings(), &victims);
-        auto logodds = detail::StealTiles(*session, settings(), &victims);
+        auto own = session.StealTiles(settings(), victims);
         for (const TileKey& key : victims) {
             if (resident.at(key).dirty) {
                 Pending& p = pending[key];
                 written_files.insert(detail::FusedFileName(key, NextVersion(key)));
                 written_files.insert(detail::LayerFileName(key, session_id));
-                std::tie(p.version, p.layer) = WriteTile(key, fused.at(key), *logodds.at(key));
+                std::tie(p.version, p.layer) = WriteTile(key, fused.at(key), own.at(key));
                 const std::string lo = detail::LayerFileName(key, session_id) + ".logodds";
                 written_files.insert(lo);
-                p.logodds = detail::WriteGrids(impl.dir, lo, {logodds.at(key)}, key);
+                p.logodds = detail::WriteGrids(impl.dir, lo, own.at(key).Grids(), key);
                 Written(p.version, p.layer);
                 stats.bytes_written += p.logodds.bytes;
             }
@@ -275,7 +259,7 @@ struct SessionWriter::State {
             ++stats.tiles_evicted;
         }
         detail::PruneInactive(work);
-        openvdb::tools::pruneInactive(session->tree());
+        session.PruneInactive();
     }
 
     void Hook(const char* step) const {
@@ -297,6 +281,11 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
     } else {
         s.impl.RequireWriter("integrate");
     }
+    // The session's crossed layer leaves out the end of each hit ray (docs/dynamic.md).
+    if (s.config.crossed_margin_m == 0.0) {
+        s.config.crossed_margin_m = kCrossedMarginM;
+        s.config.crossed_margin_fraction = kCrossedMarginFraction;
+    }
     s.config.Validate();
     const std::vector<std::string> conflicts =
         detail::RuleConflicts(s.impl.settings.integration, s.config);
@@ -315,8 +304,7 @@ SessionWriter::SessionWriter(MapStore& store, const integration::IntegrationConf
     }
     s.last_versions = detail::ReadLastVersions(*s.impl.db);
     s.work = store.EmptyMap();
-    s.session = openvdb::FloatGrid::create(0.0f);
-    s.session->setTransform(s.work.occupancy->transform().copy());
+    s.session = SessionGrids::Create(s.work.occupancy->transform());
     s.start_utc = detail::UtcNow();
     if (s.options.name.empty()) s.options.name = "session_" + std::to_string(s.session_id);
 }
@@ -370,7 +358,7 @@ void SessionWriter::Apply(const integration::ScanUpdate& update) {
     const std::set<TileKey> keys = s.TouchedTiles(own);
     s.MakeResident(keys);
     tbb::parallel_invoke([&] { integration::ApplyScanUpdate(own, s.work, s.config); },
-                         [&] { integration::ApplyOccupancyUpdate(own, *s.session, s.config); });
+                         [&] { s.session.Apply(own, s.config); });
     ++s.clock;
     for (const TileKey& key : keys) {
         State::Resident& r = s.resident.at(key);

@@ -6,6 +6,7 @@
 #include <xxhash.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -87,24 +88,38 @@ std::string ProductFileName(const TileKey& key, int64_t commit) {
     return TileDirName(key) + "/p" + std::to_string(commit) + ".vdb";
 }
 
-std::string LayerName(int64_t session, bool occupied) {
-    return "session_" + std::to_string(session) + (occupied ? "_occupied" : "_free");
+namespace {
+constexpr std::array<std::pair<LayerKind, std::string_view>, 5> kLayerKinds = {{
+    {LayerKind::kOccupied, "occupied"},
+    {LayerKind::kFree, "free"},
+    {LayerKind::kCrossed, "crossed"},
+    {LayerKind::kGrazed, "grazed"},
+    {LayerKind::kHit, "hit"},
+}};
+}  // namespace
+
+std::string LayerName(int64_t session, LayerKind kind) {
+    for (const auto& [k, name] : kLayerKinds) {
+        if (k == kind) return "session_" + std::to_string(session) + "_" + std::string(name);
+    }
+    throw InvalidArgumentError("unknown session layer kind");
 }
 
-std::pair<int64_t, bool> ParseLayerName(const std::string& name) {
+std::pair<int64_t, LayerKind> ParseLayerName(const std::string& name) {
     constexpr std::string_view prefix = "session_";
-    if (name.compare(0, prefix.size(), prefix) != 0) return {0, false};
+    const std::pair<int64_t, LayerKind> none{0, LayerKind::kOccupied};
+    if (name.compare(0, prefix.size(), prefix) != 0) return none;
     const size_t end = name.find('_', prefix.size());
-    if (end == std::string::npos || end == prefix.size() || end - prefix.size() > 18) {
-        return {0, false};
-    }
+    if (end == std::string::npos || end == prefix.size() || end - prefix.size() > 18) return none;
     const std::string id = name.substr(prefix.size(), end - prefix.size());
     if (!std::all_of(id.begin(), id.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-        return {0, false};
+        return none;
     }
     const std::string kind = name.substr(end + 1);
-    if (kind != "occupied" && kind != "free") return {0, false};
-    return {std::stoll(id), kind == "occupied"};
+    for (const auto& [k, text] : kLayerKinds) {
+        if (kind == text) return {std::stoll(id), k};
+    }
+    return none;
 }
 
 uint64_t Checksum(const std::string& bytes) { return XXH64(bytes.data(), bytes.size(), 0); }
@@ -212,17 +227,34 @@ SessionLayer DecodeLayer(const std::string& bytes, const TileKey& key, int64_t s
     SessionLayer layer;
     layer.session = session;
     for (const auto& grid : DecodeGrids(bytes, key, path)) {
-        const auto [id, occupied] = ParseLayerName(grid->getName());
+        const auto [id, kind] = ParseLayerName(grid->getName());
         auto bool_grid = openvdb::gridPtrCast<openvdb::BoolGrid>(grid);
         if (id != session || !bool_grid) {
             throw FormatError(path.string() + ": '" + grid->getName() +
                               "' is not a layer of session " + std::to_string(session));
         }
-        (occupied ? layer.occupied : layer.free) = bool_grid;
+        switch (kind) {
+            case LayerKind::kOccupied:
+                layer.occupied = bool_grid;
+                break;
+            case LayerKind::kFree:
+                layer.free = bool_grid;
+                break;
+            case LayerKind::kCrossed:
+                layer.crossed = bool_grid;
+                break;
+            case LayerKind::kGrazed:
+                layer.grazed = bool_grid;
+                break;
+            case LayerKind::kHit:
+                layer.hit = bool_grid;
+                break;
+        }
     }
-    if (!layer.occupied || !layer.free) {
+    const int since6 = !!layer.crossed + !!layer.grazed + !!layer.hit;
+    if (!layer.occupied || !layer.free || (since6 != 0 && since6 != 3)) {
         throw FormatError(path.string() + ": session " + std::to_string(session) +
-                          " has only one of its two layers");
+                          " lacks some of its layers (occupied, free; crossed, grazed, hit)");
     }
     return layer;
 }

@@ -18,10 +18,13 @@ enum class FileKind { kFused, kLayers, kProducts };
 [[nodiscard]] std::string LayerFileName(const TileKey& key, int64_t session);
 [[nodiscard]] std::string ProductFileName(const TileKey& key, int64_t commit);
 
-/// The name of a session layer grid: `session_<id>_occupied` or `session_<id>_free`.
-[[nodiscard]] std::string LayerName(int64_t session, bool occupied);
-/// (session, occupied) of a layer grid's name; session 0 for any other name.
-[[nodiscard]] std::pair<int64_t, bool> ParseLayerName(const std::string& name);
+/// The grids of a session's layer file (SessionLayer).
+enum class LayerKind { kOccupied, kFree, kCrossed, kGrazed, kHit };
+/// The name of a session layer grid: `session_<id>_occupied`, `_free`, `_crossed`, `_grazed` or
+/// `_hit`.
+[[nodiscard]] std::string LayerName(int64_t session, LayerKind kind);
+/// (session, kind) of a layer grid's name; session 0 for any other name.
+[[nodiscard]] std::pair<int64_t, LayerKind> ParseLayerName(const std::string& name);
 
 /// A file's bytes in memory, with their checksum (XXH64, seed 0).
 struct EncodedFile {
@@ -50,7 +53,7 @@ void WriteTileFile(const std::filesystem::path& path, const std::string& bytes);
 /// The fused grids of a tile from its verified file.
 [[nodiscard]] core::VoxelMap DecodeFused(const std::string& bytes, const TileKey& key,
                                          const std::filesystem::path& path);
-/// A session's two layers from its verified file.
+/// A session's layers from its verified file (two before format 6, five since).
 [[nodiscard]] SessionLayer DecodeLayer(const std::string& bytes, const TileKey& key,
                                        int64_t session, const std::filesystem::path& path);
 

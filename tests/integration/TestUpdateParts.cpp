@@ -53,10 +53,15 @@ TEST(UpdateParts, PartsOfAPartitionApplyToTheWholeUpdate) {
 }
 
 TEST(UpdateParts, EncodedUpdatesDecodeToTheSameUpdate) {
-    const IntegrationConfig config;
+    IntegrationConfig config;
+    config.crossed_margin_m = 0.5;  // a session writer's updates carry the crossed space
     core::VoxelMap map = core::VoxelMap::Create(0.1);
     const ScanUpdate update = ComputeScanUpdate(LabelledRoom(5), map, config);
     const ScanUpdate back = DecodeUpdate(EncodeUpdate(update), "rank 1");
+    ASSERT_TRUE(update.crossed && back.crossed);
+    EXPECT_TRUE(back.crossed->hasSameTopology(*update.crossed));
+    EXPECT_FALSE(
+        DecodeUpdate(EncodeUpdate(ComputeScanUpdate(LabelledRoom(5), map, {})), "rank 1").crossed);
     EXPECT_EQ(back.points, update.points);
     EXPECT_EQ(back.dropped, update.dropped);
     EXPECT_EQ(back.clipped, update.clipped);

@@ -47,9 +47,8 @@ void ExpectSameLayers(const store::MapStore& a, const store::MapStore& b) {
     ASSERT_EQ(sa.layers.size(), sb.layers.size());
     for (size_t i = 0; i < sa.layers.size(); ++i) {
         EXPECT_EQ(sa.layers[i].key, sb.layers[i].key);
-        const store::SessionLayer la = a.ReadLayer(sa.layers[i]), lb = b.ReadLayer(sb.layers[i]);
-        EXPECT_EQ(testing::FirstDifference("occupied", *la.occupied, *lb.occupied), "");
-        EXPECT_EQ(testing::FirstDifference("free", *la.free, *lb.free), "");
+        EXPECT_EQ(testing::LayerDifference(a.ReadLayer(sa.layers[i]), b.ReadLayer(sb.layers[i])),
+                  "");
     }
 }
 

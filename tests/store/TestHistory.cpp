@@ -127,7 +127,7 @@ TEST(History, AFormat4MapIsMigratedWithEverySnapshotAndLayerIdentical) {
     EXPECT_TRUE(ThrowsNaming<FormatError>(
         [&] { (void)MapStore::Open(h.dir, MapStore::Access::kRead); }, "strata upgrade"));
     MapStore map = MapStore::Open(h.dir, MapStore::Access::kWrite);
-    EXPECT_EQ(map.settings().format_version, 5);
+    EXPECT_EQ(map.settings().format_version, MapStore::kFormatVersion);
     for (const auto& [commit, fused] : at) {
         SCOPED_TRACE("commit " + std::to_string(commit));
         ExpectSameMap(map.LoadMap(map.At(commit)), fused);

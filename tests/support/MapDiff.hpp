@@ -5,6 +5,7 @@
 #include <string>
 
 #include "strata/core/VoxelMap.hpp"
+#include "strata/store/Snapshot.hpp"
 
 namespace strata::testing {
 
@@ -46,6 +47,25 @@ inline std::string MapDifference(const core::VoxelMap& actual, const core::Voxel
           FirstDifference("label", *actual.label, *expected.label),
           FirstDifference("label_weight", *actual.label_weight, *expected.label_weight),
           FirstDifference("endpoints", *actual.endpoints, *expected.endpoints)}) {
+        if (!diff.empty()) return diff;
+    }
+    return {};
+}
+
+/// "" when two sessions' layers of a tile are equal voxel by voxel (occupied, free, and crossed,
+/// grazed and hit where either has them), else the first difference.
+inline std::string LayerDifference(const store::SessionLayer& actual,
+                                   const store::SessionLayer& expected) {
+    if (!actual.crossed != !expected.crossed || !actual.grazed != !expected.grazed ||
+        !actual.hit != !expected.hit) {
+        return "one has the crossed, grazed and hit layers, the other not";
+    }
+    for (const std::string& diff :
+         {FirstDifference("occupied", *actual.occupied, *expected.occupied),
+          FirstDifference("free", *actual.free, *expected.free),
+          actual.crossed ? FirstDifference("crossed", *actual.crossed, *expected.crossed) : "",
+          actual.grazed ? FirstDifference("grazed", *actual.grazed, *expected.grazed) : "",
+          actual.hit ? FirstDifference("hit", *actual.hit, *expected.hit) : ""}) {
         if (!diff.empty()) return diff;
     }
     return {};

@@ -52,9 +52,8 @@ void ExpectSameStores(const fs::path& a_dir, const fs::path& b_dir) {
     const store::Snapshot sa = a.Latest(), sb = b.Latest();
     ASSERT_EQ(sa.layers.size(), sb.layers.size());
     for (size_t i = 0; i < sa.layers.size(); ++i) {
-        const store::SessionLayer la = a.ReadLayer(sa.layers[i]), lb = b.ReadLayer(sb.layers[i]);
-        EXPECT_EQ(testing::FirstDifference("occupied", *la.occupied, *lb.occupied), "");
-        EXPECT_EQ(testing::FirstDifference("free", *la.free, *lb.free), "");
+        EXPECT_EQ(testing::LayerDifference(a.ReadLayer(sa.layers[i]), b.ReadLayer(sb.layers[i])),
+                  "");
     }
 }
 

@@ -36,6 +36,13 @@ struct IntegrationConfig {
     /// Walk four rays at a time where the processor has AVX2 (docs/integration.md, "Speed"); off:
     /// one at a time. The same map either way.
     bool wide_walk = true;
+    /// > 0: also say which voxels the rays crossed farther from their end than this, or than
+    /// `crossed_margin_fraction` of the ray's length if that is more (ScanUpdate::crossed): the
+    /// space seen through, beyond where range noise takes a ray behind the surface it hit at a
+    /// grazing angle, which grows with range (docs/dynamic.md). Not part of the occupancy
+    /// rule; the session writer asks for it.
+    double crossed_margin_m = 0.0;
+    double crossed_margin_fraction = 0.0;
 
     /// @brief Throws InvalidArgumentError naming the first bad field.
     void Validate() const;

@@ -25,6 +25,9 @@ struct EndpointGroup {
 struct ScanUpdate {
     openvdb::MaskTree::Ptr free;      ///< voxels the rays crossed, endpoints excluded; never null
     openvdb::MaskTree::Ptr occupied;  ///< endpoint voxels; never null
+    /// The free voxels no ray crossed within its margin of its end (IntegrationConfig::
+    /// crossed_margin_m, docs/dynamic.md); null when the config asks for none.
+    openvdb::MaskTree::Ptr crossed;
     std::vector<EndpointGroup> endpoints;  ///< sorted by voxel then class
     size_t points = 0;                     ///< points in the scan
     size_t dropped = 0;                    ///< NaN/inf, or closer than min_range_m

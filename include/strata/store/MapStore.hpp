@@ -24,7 +24,7 @@ public:
     enum class Access { kRead, kWrite };
 
     /// The catalog format this build reads and writes.
-    static constexpr int kFormatVersion = 5;
+    static constexpr int kFormatVersion = 6;
 
     /// True when `dir` holds a catalog.
     [[nodiscard]] static bool IsMap(const std::filesystem::path& dir);

@@ -11,6 +11,13 @@
 
 namespace strata::store {
 
+/// What a session's crossed layer leaves out of each ray that hit something: its last metre, or
+/// its last 4 % when longer, where range noise at grazing angles takes the ray behind the
+/// surface it hit (docs/dynamic.md, "What integration records for it"). Used when the config's
+/// crossed_margin_m is 0.
+inline constexpr double kCrossedMarginM = 1.0;
+inline constexpr double kCrossedMarginFraction = 0.04;
+
 /// @brief How a session is written.
 struct SessionOptions {
     std::string name;    ///< default: session_<id>

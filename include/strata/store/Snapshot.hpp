@@ -107,12 +107,22 @@ struct Snapshot {
     std::vector<ProductFile> products;    ///< of the newest commit of each kind, by kind then key
 };
 
-/// @brief What session `session` saw in a tile: occupied and free voxels (BoolGrids named
-/// `session_<id>_occupied` / `session_<id>_free`, disjoint, active voxels true).
+/// @brief What session `session` saw in a tile (docs/store.md, "Session layers"): BoolGrids
+/// named `session_<id>_<kind>`, active voxels true. `occupied` and `free` are the session's own
+/// log-odds at its end (> 0, <= 0), disjoint. Since format 6, what its rays saw through (crossed
+/// farther from their end than the margin, IntegrationConfig::crossed_margin_m) and what its
+/// points ended in at any scan, as differences to those two: `crossed` = occupied at the end and
+/// seen through, `grazed` = free at the end and never seen through (crossed only near rays'
+/// ends), `hit` = free at the end and hit. So the space seen through is free - grazed + crossed
+/// and the space hit occupied + hit (docs/dynamic.md reads them). Sessions integrated before
+/// format 6 have none of the three: they are null.
 struct SessionLayer {
     int64_t session = 0;
     openvdb::BoolGrid::Ptr occupied;
     openvdb::BoolGrid::Ptr free;
+    openvdb::BoolGrid::Ptr crossed;
+    openvdb::BoolGrid::Ptr grazed;
+    openvdb::BoolGrid::Ptr hit;
 };
 
 }  // namespace strata::store
