@@ -14,6 +14,7 @@
 #include "strata/core/Region.hpp"
 #include "strata/pipeline/Alignment.hpp"
 #include "strata/pipeline/Diff.hpp"
+#include "strata/pipeline/Dynamic.hpp"
 #include "strata/pipeline/Localize.hpp"
 #include "strata/pipeline/MapAccess.hpp"
 #include "strata/pipeline/Vehicles.hpp"
@@ -53,6 +54,29 @@ void CheckSave(const MapStore& store, const std::string& as_of, const std::strin
                                    " is open read-only; open it with read_only=False to store " +
                                    "its " + what);
     }
+}
+
+/// The end of an analysis that edits the map (vehicles, dynamic): with `save`, `store()` commits
+/// the edited map (its leaves move into the store: the caller reads it back from there) and the
+/// report gets "commit"; otherwise the report gets the edited map itself, read-only, as "map".
+template <typename Outcome, typename StoreFn>
+py::dict StoreOrHandOver(const StoredMap& m, py::dict report,
+                         const std::shared_ptr<Outcome>& outcome, bool save, StoreFn&& store) {
+    if (save) {
+        int64_t commit = 0;
+        {
+            py::gil_scoped_release release;
+            commit = store();
+        }
+        report["commit"] = commit;
+        return report;
+    }
+    MemoryMap edited;
+    edited.map = std::shared_ptr<core::VoxelMap>(outcome, &outcome->cleaned);
+    edited.config = m.config;
+    edited.read_only = true;
+    report["map"] = py::cast(std::move(edited));
+    return report;
 }
 
 py::dict Register(const StoredMap& m, const py::array& points, const py::object& init,
@@ -137,22 +161,27 @@ py::dict Vehicles(const StoredMap& m, const std::string& as_of, const std::strin
         *outcome = pipeline::ClearVehicles(store, pipeline::SelectSnapshot(store, as_of), config);
     }
     py::dict report = ParseJson(vehicles::VehiclesJson(outcome->result, outcome->cleaned.origin));
-    if (save) {
-        // The cleaned map's leaves move into the store: the caller reads it back from there.
-        int64_t commit = 0;
-        {
-            py::gil_scoped_release release;
-            commit = pipeline::StoreVehicles(store, *outcome);
-        }
-        report["commit"] = commit;
-        return report;
+    return StoreOrHandOver(m, std::move(report), outcome, save,
+                           [&] { return pipeline::StoreVehicles(store, *outcome); });
+}
+
+py::dict Dynamic(const StoredMap& m, const std::string& as_of, const std::string& session,
+                 int margin, bool faces, size_t min_object, bool save) {
+    dynamic::DynamicConfig config;
+    config.margin_voxels = margin;
+    config.neighbourhood = faces ? dynamic::Neighbourhood::kFaces : dynamic::Neighbourhood::kCube;
+    config.min_object_voxels = min_object;
+    MapStore& store = m.Get();
+    if (save) CheckSave(store, as_of, "static map");
+    auto outcome = std::make_shared<pipeline::DynamicOutcome>();
+    {
+        py::gil_scoped_release release;
+        *outcome =
+            pipeline::FindDynamic(store, pipeline::SelectSnapshot(store, as_of), config, session);
     }
-    MemoryMap cleaned;
-    cleaned.map = std::shared_ptr<core::VoxelMap>(outcome, &outcome->cleaned);
-    cleaned.config = m.config;
-    cleaned.read_only = true;
-    report["map"] = py::cast(std::move(cleaned));
-    return report;
+    py::dict report = ParseJson(pipeline::DynamicReport(*outcome, store));
+    return StoreOrHandOver(m, std::move(report), outcome, save,
+                           [&] { return pipeline::StoreDynamic(store, *outcome); });
 }
 
 /// Centres of the active voxels of a change mask, (M, 3) in the map frame.
@@ -210,6 +239,8 @@ void AddStoredAnalyses(py::class_<StoredMap>& cls) {
             py::arg("margin"), py::arg("grow"), py::arg("support"))
         .def("vehicles", &Vehicles, py::arg("as_of"), py::arg("source"), py::arg("ray_check"),
              py::arg("refill"), py::arg("save"))
+        .def("dynamic", &Dynamic, py::arg("as_of"), py::arg("session"), py::arg("margin"),
+             py::arg("faces"), py::arg("min_object"), py::arg("save"))
         .def("walls", &Walls, py::arg("as_of"), py::arg("save"))
         .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
              py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),

@@ -315,6 +315,26 @@ class Map:
             report["map"] = self.snapshot()
         return report
 
+    def dynamic(self, as_of=None, session=None, margin: int = 1, faces: bool = False,
+                min_object: int = 8, save: bool = False) -> dict:
+        """What moved taken out of the map (docs/dynamic.md), as `strata dynamic --json`
+        reports it: objects [{object_id, voxels, min_x, ..., max_z, sessions}], removed_voxels,
+        restored_voxels, static_voxels, ... plus "map": the static map as a read-only VoxelMap.
+        session: only what that session (id or name) saw move.
+
+        save=False (the default) leaves the map on disk unchanged. save=True stores the result
+        as `strata dynamic` does (one commit: the static map, the dynamic_removed and
+        dynamic_restored grids and the dynamic table; as_of the last session still shows the
+        map as it was) and adds "commit"; "map" is then the map as stored. It needs the map open
+        for writing and no as_of."""
+        report = self._impl.dynamic("" if as_of is None else str(as_of),
+                                    "" if session is None else str(session), margin, faces,
+                                    min_object, save)
+        if save:
+            self._newest = None
+            report["map"] = self.snapshot()
+        return report
+
     def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
              gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
              support: int = 3) -> dict:

@@ -25,6 +25,7 @@ constexpr std::array<ClassInfo, kNumClasses> kClasses = {{
     {"pole", {250, 240, 160}},
     {"fence", {170, 110, 220}},
     {"other", {0, 200, 200}},
+    {"dynamic", {230, 30, 30}},
 }};
 
 }  // namespace

@@ -92,3 +92,22 @@ def test_saving_is_refused_before_any_work_and_leaves_the_map(two_copies):
         with pytest.raises(strata.InvalidArgumentError, match="source"):
             m.vehicles(save=True, source="radar")
     assert tree_digest(path) == before
+
+
+def test_saved_static_map_equals_what_the_program_stores(two_copies):
+    theirs, ours = two_copies
+    cli = json.loads(run_strata("dynamic", theirs, "--json").stdout)
+    with strata.Map.open(ours) as m:
+        found = m.dynamic(save=True)
+        static = found.pop("map").voxels(*EVERYWHERE)
+        with pytest.raises(strata.InvalidArgumentError, match="margin_voxels"):
+            m.dynamic(margin=-1)
+    with strata.Map.open(theirs, read_only=True) as m:
+        expected = m.snapshot().voxels(*EVERYWHERE)
+    # The stored commit, after the session's that the program's report names.
+    assert found.pop("commit") == cli.pop("commit") + 1
+    cli.pop("map")  # the path; Python's "map" is the static map itself
+    assert found == cli
+    assert rows(ours, "dynamic") == rows(theirs, "dynamic")
+    for key in expected:
+        np.testing.assert_array_equal(static[key], expected[key], err_msg=key)

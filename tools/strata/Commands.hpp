@@ -18,6 +18,7 @@ void RegisterMaintenance(CLI::App& app);
 void RegisterDiff(CLI::App& app);
 void RegisterWalls(CLI::App& app);
 void RegisterVehicles(CLI::App& app);
+void RegisterDynamic(CLI::App& app);
 void RegisterRegister(CLI::App& app);
 void RegisterFloors(CLI::App& app);
 void RegisterView(CLI::App& app);

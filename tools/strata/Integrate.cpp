@@ -12,6 +12,8 @@
 #include "Progress.hpp"
 #include "ScanOptions.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/pipeline/Dynamic.hpp"
+#include "strata/pipeline/MapAccess.hpp"
 
 namespace strata::tools {
 
@@ -33,6 +35,7 @@ struct IntegrateArgs {
     std::string poses_out;
     std::string on_failure = "stop";
     bool profile = false;
+    bool remove_dynamic = false;
 };
 
 // Where the session's time went (--profile; docs/integration.md, "Where the whole command's time
@@ -46,6 +49,19 @@ void PrintProfile(const pipeline::IntegrateResult& r) {
               << " s, marking " << s.update_seconds.mark << " s, applying " << s.apply_seconds
               << " s, writing tiles " << s.write_seconds << " s, catalog " << catalog
               << " s, other " << other << " s\n";
+}
+
+// --remove-dynamic: what moved taken out of the map just committed, as `strata dynamic` does (its
+// own commit after the session's).
+void RemoveDynamic(const std::string& dir) {
+    store::MapStore map = pipeline::OpenMap(dir, store::MapStore::Access::kWrite);
+    pipeline::DynamicOutcome outcome = pipeline::FindDynamic(map, map.Latest(), {});
+    const dynamic::DynamicResult& found = outcome.result;
+    std::cout << "dynamic: " << found.objects.size() << " moving objects, "
+              << found.removed_voxels() << " voxels removed, " << found.restored_voxels()
+              << " eroded static voxels kept";
+    const int64_t commit = pipeline::StoreDynamic(map, outcome);
+    std::cout << "; the static map stored (commit " << commit << ")\n";
 }
 
 // The map the flags ask for: only the flags the user gave are checked against an existing map.
@@ -135,6 +151,7 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
               << " MB), commit " << r.stats.commit_seconds << " s; map has " << r.map_tiles
               << " tiles\n";
     if (args.profile && CommandRanks().size() == 1) PrintProfile(r);
+    if (args.remove_dynamic && CommandRanks().root()) RemoveDynamic(args.map);
     if (CommandRanks().size() > 1) {
         std::cout << "rank 0 of " << CommandRanks().size() << ": " << r.steps.cast
                   << " s reading and casting its scans, " << r.steps.exchange
@@ -187,6 +204,9 @@ void RegisterIntegrate(CLI::App& app) {
         "--no-point-means", [args](int64_t) { args->config.keep_point_means = false; },
         "Do not keep each voxel's mean endpoint (faster, half the memory; wall slants then "
         "fall back to voxel centres)");
+    cmd->add_flag("--remove-dynamic", args->remove_dynamic,
+                  "Then take what moved out of the map (strata dynamic, its own commit; "
+                  "docs/dynamic.md)");
     cmd->add_flag("--align", args->align,
                   "Align the session to the map first (strata register); refuse and commit "
                   "nothing when it fails; the transform is kept as the session's alignment");

@@ -97,6 +97,7 @@ int RunCommand(int argc, char** argv, const strata::pipeline::Ranks& ranks) {
     strata::tools::RegisterDiff(app);
     strata::tools::RegisterWalls(app);
     strata::tools::RegisterVehicles(app);
+    strata::tools::RegisterDynamic(app);
     strata::tools::RegisterRegister(app);
     strata::tools::RegisterFloors(app);
     strata::tools::RegisterBag(app);

@@ -19,8 +19,9 @@ enum class SemanticClass : uint8_t {
     kPole,
     kFence,
     kOther,
+    kDynamic,  ///< held something that moved (docs/dynamic.md): set by `strata dynamic`
 };
-inline constexpr int kNumClasses = 10;
+inline constexpr int kNumClasses = 11;
 
 struct Rgb {
     uint8_t r, g, b;

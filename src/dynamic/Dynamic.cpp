@@ -1,0 +1,177 @@
+#include "strata/dynamic/Dynamic.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <string>
+
+#include "strata/core/Error.hpp"
+#include "strata/core/Labels.hpp"
+
+namespace strata::dynamic {
+namespace {
+
+// The offsets a candidate's neighbourhood spans (itself included).
+std::vector<openvdb::Coord> Offsets(const DynamicConfig& config) {
+    std::vector<openvdb::Coord> out;
+    const int r = config.margin_voxels;
+    for (int dx = -r; dx <= r; ++dx) {
+        for (int dy = -r; dy <= r; ++dy) {
+            for (int dz = -r; dz <= r; ++dz) {
+                const int l1 = std::abs(dx) + std::abs(dy) + std::abs(dz);
+                if (config.neighbourhood == Neighbourhood::kFaces && l1 > r) continue;
+                out.emplace_back(dx, dy, dz);
+            }
+        }
+    }
+    return out;
+}
+
+// The candidates of one leaf of `hit`, split by whether their whole neighbourhood was crossed.
+struct LeafVerdict {
+    std::vector<openvdb::Coord> removed, restored;
+};
+
+// Groups of the removed voxels linked by steps of at most `gap` voxels along every axis, in
+// order of their first voxel.
+std::vector<std::vector<openvdb::Coord>> Groups(std::vector<openvdb::Coord> voxels, int gap) {
+    std::sort(voxels.begin(), voxels.end());
+    openvdb::MaskTree left;
+    for (const openvdb::Coord& c : voxels) left.setValueOn(c);
+    openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(left);
+    std::vector<std::vector<openvdb::Coord>> groups;
+    for (const openvdb::Coord& seed : voxels) {
+        if (!acc.isValueOn(seed)) continue;
+        std::vector<openvdb::Coord> group{seed};
+        acc.setValueOff(seed);
+        for (size_t i = 0; i < group.size(); ++i) {
+            const openvdb::Coord c = group[i];
+            for (int dx = -gap; dx <= gap; ++dx) {
+                for (int dy = -gap; dy <= gap; ++dy) {
+                    for (int dz = -gap; dz <= gap; ++dz) {
+                        const openvdb::Coord n = c.offsetBy(dx, dy, dz);
+                        if (!acc.isValueOn(n)) continue;
+                        acc.setValueOff(n);
+                        group.push_back(n);
+                    }
+                }
+            }
+        }
+        groups.push_back(std::move(group));
+    }
+    return groups;
+}
+
+}  // namespace
+
+void DynamicConfig::Validate() const {
+    if (margin_voxels < 0 || margin_voxels > 4) {
+        throw InvalidArgumentError("margin_voxels must be in [0, 4], not " +
+                                   std::to_string(margin_voxels));
+    }
+    if (object_gap_voxels < 1 || object_gap_voxels > 8) {
+        throw InvalidArgumentError("object_gap_voxels must be in [1, 8], not " +
+                                   std::to_string(object_gap_voxels));
+    }
+    if (!(restored_log_odds > 0.0F)) {
+        throw InvalidArgumentError("restored_log_odds must be > 0 (occupied)");
+    }
+    if (!(removed_log_odds <= 0.0F)) {
+        throw InvalidArgumentError("removed_log_odds must be <= 0 (free)");
+    }
+}
+
+size_t DynamicResult::restored_voxels() const {
+    return restored ? static_cast<size_t>(restored->activeVoxelCount()) : 0;
+}
+
+DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
+                          const DynamicConfig& config) {
+    config.Validate();
+    if (!seen.crossed || !seen.hit) {
+        throw InvalidArgumentError("the space the rays crossed and hit is needed");
+    }
+    const std::vector<openvdb::Coord> offsets = Offsets(config);
+    std::vector<const openvdb::MaskTree::LeafNodeType*> leaves;
+    seen.hit->tree().getNodes(leaves);
+    std::vector<LeafVerdict> verdicts(leaves.size());
+    const openvdb::FloatTree& occupancy = map.occupancy->tree();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& range) {
+        openvdb::tree::ValueAccessor<const openvdb::FloatTree> occ(occupancy);
+        openvdb::tree::ValueAccessor<const openvdb::MaskTree> crossed(seen.crossed->tree());
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            for (auto on = leaves[i]->cbeginValueOn(); on; ++on) {
+                const openvdb::Coord c = on.getCoord();
+                float value = 0.0F;
+                // Occupied now, or never observed (cleared by another analysis): not a candidate.
+                if (!occ.probeValue(c, value) || (value > 0.0F && !config.occupied_too)) continue;
+                const bool through =
+                    std::all_of(offsets.begin(), offsets.end(),
+                                [&](const auto& d) { return crossed.isValueOn(c + d); });
+                if (through) {
+                    verdicts[i].removed.push_back(c);
+                } else if (value <= 0.0F) {
+                    verdicts[i].restored.push_back(c);
+                }
+            }
+        }
+    });
+
+    DynamicResult result;
+    result.removed = openvdb::Int32Grid::create(0);
+    result.removed->setTransform(map.occupancy->transform().copy());
+    result.removed->setName(grid_names::kRemoved);
+    result.restored = openvdb::BoolGrid::create(false);
+    result.restored->setTransform(map.occupancy->transform().copy());
+    result.restored->setName(grid_names::kRestored);
+    std::vector<openvdb::Coord> removed;
+    for (const LeafVerdict& v : verdicts) {
+        removed.insert(removed.end(), v.removed.begin(), v.removed.end());
+        for (const openvdb::Coord& c : v.restored) result.restored->tree().setValueOn(c, true);
+        result.candidates += v.removed.size() + v.restored.size();
+        for (const openvdb::Coord& c : v.removed)
+            result.removed_occupied += occupancy.getValue(c) > 0.0F;
+    }
+    const double s = map.voxel_size;
+    for (std::vector<openvdb::Coord>& group :
+         Groups(std::move(removed), config.object_gap_voxels)) {
+        int32_t id = 0;
+        if (group.size() >= config.min_object_voxels) {
+            MovingObject object;
+            object.id = static_cast<int32_t>(result.objects.size() + 1);
+            object.voxels = group.size();
+            for (const openvdb::Coord& c : group) {
+                object.box.extend(Eigen::Vector3d(c.x(), c.y(), c.z()) * s);
+                object.box.extend(Eigen::Vector3d(c.x() + 1, c.y() + 1, c.z() + 1) * s);
+            }
+            id = object.id;
+            result.objects.push_back(object);
+        } else {
+            result.scattered += group.size();
+        }
+        for (const openvdb::Coord& c : group) result.removed->tree().setValueOn(c, id);
+    }
+    for (auto on = map.occupancy->tree().cbeginValueOn(); on; ++on) {
+        if (*on > 0.0F) result.occupied += on.getVoxelCount();
+    }
+    result.static_voxels = result.occupied + result.restored_voxels();
+    return result;
+}
+
+void ApplyDynamic(const DynamicResult& result, const DynamicConfig& config, core::VoxelMap& map) {
+    config.Validate();
+    auto& occupancy = map.occupancy->tree();
+    for (auto on = result.restored->tree().cbeginValueOn(); on; ++on) {
+        occupancy.setValueOn(on.getCoord(), config.restored_log_odds);
+    }
+    const auto dynamic = static_cast<int32_t>(core::SemanticClass::kDynamic);
+    for (auto on = result.removed->tree().cbeginValueOn(); on; ++on) {
+        const openvdb::Coord c = on.getCoord();
+        if (occupancy.getValue(c) > 0.0F) occupancy.setValueOn(c, config.removed_log_odds);
+        map.endpoints->tree().setValueOff(c, 0);
+        map.label->tree().setValueOn(c, dynamic);
+    }
+}
+
+}  // namespace strata::dynamic
