@@ -67,12 +67,6 @@ dynamic::SeenSpace SeenFrom(const store::MapStore& map,
 
 }  // namespace
 
-dynamic::SeenSpace ReadSeenSpace(const store::MapStore& map, const store::Snapshot& snapshot,
-                                 int64_t only) {
-    const std::vector<store::SessionLayer> layers = ReadLayers(map, snapshot);
-    return SeenFrom(map, layers, HitsBySession(map, layers), only);
-}
-
 DynamicOutcome FindDynamic(const store::MapStore& map, const store::Snapshot& snapshot,
                            const dynamic::DynamicConfig& config, const std::string& session) {
     config.Validate();

@@ -30,6 +30,10 @@ SessionGrids SessionGrids::Create(const openvdb::math::Transform& transform) {
     g.logodds->setTransform(transform.copy());
     g.crossed->setTransform(transform.copy());
     g.hit->setTransform(transform.copy());
+    // Named once: the per-tile grids StealTiles makes keep the names.
+    g.logodds->setName(kLogOdds);
+    g.crossed->setName(kCrossed);
+    g.hit->setName(kHit);
     return g;
 }
 
@@ -86,12 +90,7 @@ size_t SessionGrids::MemUsage() const {
     return logodds->memUsage() + crossed->memUsage() + hit->memUsage();
 }
 
-openvdb::GridPtrVec SessionGrids::Grids() const {
-    logodds->setName(kLogOdds);
-    crossed->setName(kCrossed);
-    hit->setName(kHit);
-    return {logodds, crossed, hit};
-}
+openvdb::GridPtrVec SessionGrids::Grids() const { return {logodds, crossed, hit}; }
 
 openvdb::GridPtrVec LayerGrids(int64_t session, const SessionGrids& tile) {
     using Mask = openvdb::BoolTree::LeafNodeType::NodeMaskType;

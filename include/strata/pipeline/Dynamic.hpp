@@ -21,13 +21,6 @@ struct DynamicOutcome {
     int64_t session = 0;  ///< the session whose moving things were looked for (0: every one)
 };
 
-/// @brief The space every session of the snapshot crossed, and hit: session `only` (0: every
-/// session) for the hits.
-/// @throw RefusedError naming a session integrated before its layers recorded that (format 6):
-/// it must be integrated again; NotFoundError for an `only` the snapshot does not have.
-[[nodiscard]] dynamic::SeenSpace ReadSeenSpace(const store::MapStore& map,
-                                               const store::Snapshot& snapshot, int64_t only = 0);
-
 /// @brief Finds the snapshot's moving things (dynamic::FindDynamic on its fused map, loaded
 /// whole) and makes the static map; the map on disk is not changed. `session` (an id or a name;
 /// empty: every session) limits the search to the voxels that session's points ended in.
