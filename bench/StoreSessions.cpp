@@ -203,11 +203,11 @@ std::vector<std::string> BenchMigration(const std::vector<core::Scan>& scans, si
     }
     const bool clean = map.Check().ok() && map.Check().unreferenced.empty();
     std::printf(
-        "\n| migration | sessions | format 4 MB | format 5 MB | migration s | every snapshot and "
+        "\n| migration | sessions | format 4 MB | format %d MB | migration s | every snapshot and "
         "layer identical | check clean |\n|---|---|---|---|---|---|---|\n"
-        "| format 4 -> 5 | %zu | %.1f | %.1f | %.2f | %s | %s |\n",
-        sessions, Mb(format4), Mb(DiskBytes(dir)), seconds, same ? "yes" : "no",
-        clean ? "yes" : "no");
+        "| format 4 -> %d | %zu | %.1f | %.1f | %.2f | %s | %s |\n",
+        store::MapStore::kFormatVersion, store::MapStore::kFormatVersion, sessions, Mb(format4),
+        Mb(DiskBytes(dir)), seconds, same ? "yes" : "no", clean ? "yes" : "no");
     if (!same) missed.push_back("the migration changed a snapshot or a layer");
     if (!clean) missed.push_back("the migrated map does not check clean");
     fs::remove_all(dir);

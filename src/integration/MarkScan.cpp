@@ -83,10 +83,6 @@ void ClearColumn(const VoxelBox& box, uint64_t* bits, int64_t bx, int64_t by) {
     }
 }
 
-// Whether a prepared ray was walked: its last voxels may lie behind the surface it hit (by the
-// range noise), or, clipped at the maximum range, behind the surface it was going to hit.
-bool IsRay(const PreparedScan& scan, size_t i) { return scan.kinds[i] != PointKind::kDropped; }
-
 ScanMasks MarkDense(const PreparedScan& scan, bool wide, const NearEndMargin& margin,
                     Bitmaps& bitmaps) {
     const VoxelBox& box = scan.box;
@@ -95,30 +91,26 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide, const NearEndMargin& ma
     bitmaps.clean = false;
     for (Bitmap& b : bitmaps.free) b.used = false;
     for (Bitmap& b : bitmaps.near_end) b.used = false;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                          Bitmap& mine = bitmaps.free.local();
-                          mine.used = true;
-                          uint64_t* const bits = mine.Zeroed(n_words);
-                          const auto mark = [bits](int64_t pos) {
-                              bits[pos >> 6] |= uint64_t{1} << (pos & 63);
-                          };
-                          if (wide) {
-                              TraceRaysWide(scan, range, bits);
-                          } else {
-                              TraceRays(scan, range, mark, bits);
-                          }
-                          if (margin.metres <= 0.0) return;
-                          Bitmap& near = bitmaps.near_end.local();
-                          near.used = true;
-                          uint64_t* const near_bits = near.Zeroed(n_words);
-                          for (size_t i = range.begin(); i != range.end(); ++i) {
-                              if (!IsRay(scan, i)) continue;
-                              WalkNearEnd(scan, i, margin, [near_bits](int64_t pos) {
-                                  near_bits[pos >> 6] |= uint64_t{1} << (pos & 63);
-                              });
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
+        [&](const tbb::blocked_range<size_t>& range) {
+            Bitmap& mine = bitmaps.free.local();
+            mine.used = true;
+            uint64_t* const bits = mine.Zeroed(n_words);
+            const auto mark = [bits](int64_t pos) { bits[pos >> 6] |= uint64_t{1} << (pos & 63); };
+            if (margin.metres <= 0.0) {
+                wide ? TraceRaysWide(scan, range, bits) : TraceRays(scan, range, mark, bits);
+                return;
+            }
+            Bitmap& near = bitmaps.near_end.local();
+            near.used = true;
+            uint64_t* const near_bits = near.Zeroed(n_words);
+            const auto mark_near = [near_bits](int64_t pos) {
+                near_bits[pos >> 6] |= uint64_t{1} << (pos & 63);
+            };
+            wide ? TraceRaysWide(scan, range, bits, margin, near_bits)
+                 : TraceRays(scan, range, mark, bits, margin, mark_near);
+        });
     uint64_t* const occupied_words = bitmaps.occupied.Zeroed(n_words);
     for (const int64_t pos : scan.endpoint_pos) {
         occupied_words[pos >> 6] |= uint64_t{1} << (pos & 63);
@@ -209,29 +201,28 @@ ScanMasks MarkDense(const PreparedScan& scan, bool wide, const NearEndMargin& ma
 // Bounded-memory path for scans whose box is too large for a bitmap.
 ScanMasks MarkSparse(const PreparedScan& scan, const NearEndMargin& margin) {
     const VoxelBox& box = scan.box;
-    tbb::enumerable_thread_specific<openvdb::MaskTree> free_trees;
+    struct Trees {
+        openvdb::MaskTree free, near;
+    };
+    tbb::enumerable_thread_specific<Trees> trees;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, RayCount(scan), kRayGrain),
                       [&](const tbb::blocked_range<size_t>& range) {
-                          openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(free_trees.local());
-                          TraceRays(
-                              scan, range, [&](int64_t pos) { acc.setValueOn(box.CoordOf(pos)); },
-                              nullptr);
+                          Trees& mine = trees.local();
+                          openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(mine.free);
+                          const auto mark = [&](int64_t pos) { acc.setValueOn(box.CoordOf(pos)); };
+                          if (margin.metres <= 0.0) return TraceRays(scan, range, mark, nullptr);
+                          openvdb::tree::ValueAccessor<openvdb::MaskTree> near(mine.near);
+                          TraceRays(scan, range, mark, nullptr, margin,
+                                    [&](int64_t pos) { near.setValueOn(box.CoordOf(pos)); });
                       });
     ScanMasks masks;
-    for (const auto& tree : free_trees) masks.free->topologyUnion(tree);
+    for (const Trees& t : trees) masks.free->topologyUnion(t.free);
     openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(*masks.occupied);
     for (const int64_t pos : scan.endpoint_pos) acc.setValueOn(box.CoordOf(pos));
     masks.free->topologyDifference(*masks.occupied);
     if (margin.metres > 0.0) {
-        openvdb::MaskTree near;
-        openvdb::tree::ValueAccessor<openvdb::MaskTree> near_acc(near);
-        for (size_t i = 0; i < RayCount(scan); ++i) {
-            if (!IsRay(scan, i)) continue;
-            WalkNearEnd(scan, i, margin,
-                        [&](int64_t pos) { near_acc.setValueOn(box.CoordOf(pos)); });
-        }
         masks.crossed = std::make_shared<openvdb::MaskTree>(*masks.free);
-        masks.crossed->topologyDifference(near);
+        for (const Trees& t : trees) masks.crossed->topologyDifference(t.near);
     }
     return masks;
 }

@@ -3,10 +3,7 @@
 // "Semantics"), marked into per-thread bitmaps over the scan's bounding box.
 
 #include <Eigen/Core>
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <vector>
 
@@ -92,53 +89,13 @@ struct ScanMasks {
     openvdb::MaskTree::Ptr crossed;
 };
 
-/// How far from its end a ray's voxels are not counted as crossed (IntegrationConfig).
+/// How far from its end a ray's voxels are not counted as crossed (IntegrationConfig): the
+/// voxels the ray's walk leaves beyond length - margin, the end's voxel included
+/// (TraceRay.hpp's NearFrom), are near it.
 struct NearEndMargin {
     double metres = 0.0;
     double fraction = 0.0;  ///< of the ray's length, when more
 };
-
-/// Calls `mark(pos)` with the box index of every voxel ray `i` (hit or clipped) crosses within
-/// the margin of its end, the end's voxel included: an exact 3D DDA walked from the end towards
-/// the origin, in double precision; voxels outside the box are skipped.
-template <typename MarkFn>
-void WalkNearEnd(const PreparedScan& scan, size_t i, const NearEndMargin& margin, MarkFn&& mark) {
-    const Eigen::Vector3d& end = scan.ends[i];
-    const Eigen::Vector3d back = scan.origin - end;
-    const double ray = back.norm();
-    const double length = std::min(std::max(margin.metres, margin.fraction * ray), ray);
-    const Eigen::Vector3d dir = back.normalized();
-    const double s = scan.voxel_size;
-    int64_t c[3], step[3];
-    double t_max[3], t_delta[3];
-    for (int a = 0; a < 3; ++a) {
-        c[a] = static_cast<int64_t>(std::floor(end[a] * scan.inv_voxel_size));
-        if (dir[a] > 0.0) {
-            step[a] = 1, t_max[a] = (static_cast<double>(c[a] + 1) * s - end[a]) / dir[a];
-            t_delta[a] = s / dir[a];
-        } else if (dir[a] < 0.0) {
-            step[a] = -1, t_max[a] = (static_cast<double>(c[a]) * s - end[a]) / dir[a];
-            t_delta[a] = -s / dir[a];
-        } else {
-            step[a] = 0, t_max[a] = t_delta[a] = std::numeric_limits<double>::infinity();
-        }
-    }
-    const VoxelBox& box = scan.box;
-    const int64_t n[3] = {box.nx, box.ny, box.nz};
-    const int64_t lo[3] = {box.lo.x(), box.lo.y(), box.lo.z()};
-    const auto steps = static_cast<int64_t>(3.0 * (length / s + 2.0));
-    for (int64_t k = 0; k <= steps; ++k) {
-        const int64_t x = c[0] - lo[0], y = c[1] - lo[1], z = c[2] - lo[2];
-        if (x >= 0 && y >= 0 && z >= 0 && x < n[0] && y < n[1] && z < n[2]) {
-            mark((x * box.ny + y) * box.nz + z);
-        }
-        const int a =
-            t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
-        if (t_max[a] > length) break;
-        c[a] += step[a];
-        t_max[a] += t_delta[a];
-    }
-}
 
 struct Bitmaps;
 

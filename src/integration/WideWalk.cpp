@@ -13,7 +13,9 @@
 //
 // Lanes run the untested steps of their rays (TraceRay's `steps - 4`) in rounds as long as the
 // shortest lane's remainder; a lane whose ray has no untested step left finishes it alone with
-// the tested steps (StepsWithTests) and takes the next ray of the range.
+// the tested steps (StepsWithTests) and takes the next ray of the range. When the crossed space
+// is asked for, a lane's untested steps end before its ray's last margin (StepsBeforeNear), and
+// the lane's scalar finish marks what lies beyond.
 #include <immintrin.h>
 
 #include <algorithm>
@@ -37,6 +39,7 @@ struct Lanes {
     alignas(32) int64_t stride[3][kLanes];
     int64_t left[kLanes];
     RaySetup ray[kLanes];
+    double near_from[kLanes] = {};  // with the crossed space: NearFrom of each lane's ray
 };
 
 struct Marker {
@@ -184,18 +187,20 @@ void SetUp(const RayStarts<T>& starts, const size_t (&index)[4], int n, RaySetup
 }
 
 // The rest of lane `l`'s ray, alone: its untested steps left, then the tested ones.
-void Finish(const Lanes& lanes, int l, uint64_t box_size, uint64_t* words) {
+template <typename NearFn>
+void Finish(const Lanes& lanes, int l, uint64_t box_size, uint64_t* words, NearFn& near) {
     const RaySetup& ray = lanes.ray[l];
     double t[3] = {lanes.t[0][l], lanes.t[1][l], lanes.t[2][l]};
     const double d[3] = {ray.t_delta[0], ray.t_delta[1], ray.t_delta[2]};
     Marker mark{words};
     PosCursor<Marker> at{lanes.pos[l], ray.stride[0], ray.stride[1], ray.stride[2], mark};
     StepsWithoutTests(lanes.left[l], t, d, at);
-    StepsWithTests(at.Pos(), t, ray, box_size, mark);
+    StepsWithTests(at.Pos(), t, ray, box_size, mark, lanes.near_from[l], near);
 }
 
-template <typename T>
-void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uint64_t* words) {
+template <typename T, typename NearFn>
+void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uint64_t* words,
+          const NearEndMargin& margin, NearFn near) {
     const RayStarts<T> starts(scan);
     const auto box_size = static_cast<uint64_t>(scan.box.size());
     const Marker mark{words};
@@ -222,8 +227,13 @@ void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uin
     const auto load = [&](int l) {
         RaySetup ray;
         while (next_ray(ray)) {
-            if (ray.steps <= 4) {
-                TraceRay(ray, box_size, mark, nullptr);
+            int64_t untested = ray.steps - 4;
+            if constexpr (kMarksNearEnd<NearFn>) {
+                lanes.near_from[l] = NearFrom(ray, margin);
+                untested = std::min(untested, StepsBeforeNear(ray, lanes.near_from[l]));
+            }
+            if (untested <= 0) {
+                TraceRay(ray, box_size, mark, nullptr, margin, near);
                 continue;
             }
             mark(ray.start);  // OctoMap adds the origin's key before any test
@@ -234,7 +244,7 @@ void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uin
                 lanes.stride[a][l] = ray.stride[a];
             }
             lanes.pos[l] = ray.start;
-            lanes.left[l] = ray.steps - 4;
+            lanes.left[l] = untested;
             return true;
         }
         return false;
@@ -247,13 +257,13 @@ void Walk(const PreparedScan& scan, const tbb::blocked_range<size_t>& range, uin
         for (int l = 0; l < kLanes; ++l) {
             lanes.left[l] -= steps;
             if (lanes.left[l] == 0) {
-                Finish(lanes, l, box_size, words);
+                Finish(lanes, l, box_size, words, near);
                 live[l] = load(l);
             }
         }
     }
     for (int l = 0; l < kLanes; ++l) {
-        if (live[l]) Finish(lanes, l, box_size, words);
+        if (live[l]) Finish(lanes, l, box_size, words, near);
     }
 }
 
@@ -265,8 +275,12 @@ bool WideWalkAvailable() {
 }
 
 void TraceRaysWide(const PreparedScan& scan, const tbb::blocked_range<size_t>& range,
-                   uint64_t* words) {
-    scan.float_rays ? Walk<float>(scan, range, words) : Walk<double>(scan, range, words);
+                   uint64_t* words, const NearEndMargin& margin, uint64_t* near_words) {
+    const auto walk = [&](auto near) {
+        scan.float_rays ? Walk<float>(scan, range, words, margin, near)
+                        : Walk<double>(scan, range, words, margin, near);
+    };
+    near_words != nullptr ? walk(Marker{near_words}) : walk(NoNearEnd{});
 }
 
 }  // namespace strata::integration::detail
