@@ -54,12 +54,14 @@ if ((${#missing[@]})); then
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# The independent writers of the MCAP test recordings (tests/recordings/write_mcap.mjs), from the
-# machine's npm registry into the ignored build-deps/npm/ (tests set NODE_PATH there). Pinned by
-# major version; installed once.
+# The independent writers of the MCAP test recordings (tests/recordings/write_mcap.mjs) and the
+# independent reader of exported PCD files (tests/io/read_pcd.mjs), from the machine's npm
+# registry into the ignored build-deps/npm/ (tests set NODE_PATH there). Pinned by major version;
+# installed once.
 npm_dir="$(cd "$(dirname "$0")/.." && pwd)/build-deps/npm"
 if [[ ! -d $npm_dir/node_modules/@mcap/core || ! -d $npm_dir/node_modules/@foxglove/rosmsg ||
-      ! -d $npm_dir/node_modules/@foxglove/rosmsg2-serialization ]]; then
+      ! -d $npm_dir/node_modules/@foxglove/rosmsg2-serialization ||
+      ! -d $npm_dir/node_modules/@loaders.gl/pcd || ! -d $npm_dir/node_modules/@loaders.gl/core ]]; then
   if ! command -v npm >/dev/null; then
     sudo_cmd=()
     [[ $(id -u) -eq 0 ]] || sudo_cmd=(sudo)
@@ -67,7 +69,8 @@ if [[ ! -d $npm_dir/node_modules/@mcap/core || ! -d $npm_dir/node_modules/@foxgl
   fi
   mkdir -p "$npm_dir"
   npm install --prefix "$npm_dir" --no-audit --no-fund --loglevel=error \
-    @mcap/core@2 @foxglove/rosmsg2-serialization@3 @foxglove/rosmsg@5
+    @mcap/core@2 @foxglove/rosmsg2-serialization@3 @foxglove/rosmsg@5 @loaders.gl/core@4 \
+    @loaders.gl/pcd@4
 fi
 
 # The source package of the installed libtbb, for tools/sanitize.sh tsan: ThreadSanitizer needs

@@ -83,9 +83,11 @@ py::list SessionList(const StoredMap& m) {
 }
 
 std::string ExportStoredMap(const StoredMap& self, const std::string& path,
-                            const std::string& format, const std::string& as_of) {
+                            const std::string& format, const std::string& as_of,
+                            const std::string& points) {
     pipeline::ExportOptions options;
     options.format = format;
+    options.points = points;
     options.memory_budget_bytes = 0;  // as Map.load: the whole snapshot in memory when it must be
     const MapStore& store = self.Get();
     py::gil_scoped_release release;
@@ -123,7 +125,7 @@ void RegisterStoredMap(py::module_& m) {
                  return self.Get().FindSession(id_or_name);
              })
         .def("export", &ExportStoredMap, py::arg("path"), py::arg("format") = "",
-             py::arg("as_of") = "")
+             py::arg("as_of") = "", py::arg("points") = "")
         .def_property_readonly("path",
                                [](const StoredMap& self) { return self.Get().dir().string(); })
         .def_property_readonly("writable",

@@ -384,7 +384,10 @@ class Map:
         return self._impl.localize(points, int(floor), init, l1, l2, min_range, max_range,
                                    min_overlap, max_rmse)
 
-    def export(self, path, format: str = "", as_of=None) -> str:
-        """Writes the map (or its state as of a session) as vdb, bt, ot, ply or png
-        (default: from the file name); returns the format written."""
-        return self._impl.export(str(path), format, "" if as_of is None else str(as_of))
+    def export(self, path, format: str = "", as_of=None, points=None) -> str:
+        """Writes the map (or its state as of a session) as vdb, bt, ot, ply, pcd or png
+        (default: from the file name); returns the format written. With `points` (a point
+        cloud file), a pcd of that cloud's points whose voxel the map has occupied (the
+        dynamic-map benchmark's format, docs/dynamic.md)."""
+        return self._impl.export(str(path), format, "" if as_of is None else str(as_of),
+                                 "" if points is None else str(points))

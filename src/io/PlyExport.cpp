@@ -14,18 +14,6 @@
 namespace strata::io {
 namespace {
 
-constexpr size_t kFlushBytes = size_t{1} << 20;
-
-// Appends the little-endian bytes of a float or double, whatever the host byte order.
-template <typename T, typename UInt>
-void AppendLittleEndian(std::vector<char>& out, T value) {
-    static_assert(sizeof(T) == sizeof(UInt));
-    UInt bits = 0;
-    std::memcpy(&bits, &value, sizeof(T));
-    for (size_t i = 0; i < sizeof(T); ++i)
-        out.push_back(static_cast<char>((bits >> (8 * i)) & 0xFF));
-}
-
 std::string Header(const core::VoxelMap& map, uint64_t count, bool use_double) {
     const char* type = use_double ? "double" : "float";
     std::ostringstream h;
@@ -66,37 +54,18 @@ void WritePly(const core::VoxelMap& frame, const MapParts& parts,
 
     WriteFileAtomically(path, [&](std::ostream& os) {
         os << Header(frame, count, use_double);
-        std::vector<char> buffer;
-        buffer.reserve(kFlushBytes + 64);
-        uint64_t written = 0;
+        detail::RecordWriter out(os, count, path);
         parts([&](const core::VoxelMap& part) {
             openvdb::Int32Grid::ConstAccessor labels = part.label->getConstAccessor();
             detail::ForEachOccupiedVoxel(*part.occupancy, [&](const openvdb::Coord& ijk, float) {
-                const Eigen::Vector3d p = frame.VoxelCenter(ijk) + frame.origin;
-                for (int axis = 0; axis < 3; ++axis) {
-                    if (use_double) {
-                        AppendLittleEndian<double, uint64_t>(buffer, p[axis]);
-                    } else {
-                        AppendLittleEndian<float, uint32_t>(buffer, static_cast<float>(p[axis]));
-                    }
-                }
+                out.Position(frame.VoxelCenter(ijk) + frame.origin, use_double);
                 const core::SemanticClass c = detail::ClassOf(labels.getValue(ijk));
                 const core::Rgb rgb = core::ClassColor(c);
-                for (uint8_t byte : {rgb.r, rgb.g, rgb.b, static_cast<uint8_t>(c)}) {
-                    buffer.push_back(static_cast<char>(byte));
-                }
-                ++written;
-                if (buffer.size() >= kFlushBytes) {
-                    os.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-                    buffer.clear();
-                }
+                for (uint8_t byte : {rgb.r, rgb.g, rgb.b, static_cast<uint8_t>(c)}) out.Byte(byte);
+                out.Next();
             });
         });
-        if (written != count) {
-            throw InvalidArgumentError("cannot export to '" + path.string() +
-                                       "': the map's parts changed between the two passes");
-        }
-        os.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+        out.Finish();
     });
 }
 

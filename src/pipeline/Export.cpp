@@ -1,5 +1,6 @@
 #include "strata/pipeline/Export.hpp"
 
+#include <algorithm>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -7,8 +8,10 @@
 #include "strata/core/Error.hpp"
 #include "strata/io/AtomicFile.hpp"
 #include "strata/io/OctomapExport.hpp"
+#include "strata/io/PcdExport.hpp"
 #include "strata/io/PlyExport.hpp"
 #include "strata/io/PngExport.hpp"
+#include "strata/io/PointCloudReaders.hpp"
 #include "strata/io/VdbExport.hpp"
 #include "strata/store/TileReader.hpp"
 
@@ -16,9 +19,9 @@ namespace strata::pipeline {
 
 void ExportOptions::Validate() const {
     if (!format.empty() && format != "vdb" && format != "bt" && format != "ot" && format != "ply" &&
-        format != "png") {
+        format != "pcd" && format != "png") {
         throw InvalidArgumentError("unknown export format '" + format +
-                                   "' (use vdb, bt, ot, ply or png)");
+                                   "' (use vdb, bt, ot, ply, pcd or png)");
     }
     if (pixels_per_voxel < 1) throw InvalidArgumentError("pixels_per_voxel must be >= 1");
     if (color != "auto" && color != "class" && color != "height") {
@@ -43,8 +46,59 @@ std::string ExportFormat(const std::filesystem::path& out, const ExportOptions& 
     if ((format == "bt" || format == "ot") && out.extension() != "." + format) {
         throw InvalidArgumentError(out.string() + ": OctoMap files must end in ." + format);
     }
+    if (!options.points.empty() && options.split) {
+        throw InvalidArgumentError(out.string() +
+                                   ": a cloud's kept points go to one file, not one per tile");
+    }
+    if (!options.points.empty() && format != "pcd") {
+        throw InvalidArgumentError(out.string() + ": a cloud's kept points (" +
+                                   options.points.string() + ") are written as pcd, not " + format);
+    }
     return format;
 }
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A point cloud file's points in a map's frame, each with its voxel.
+struct CloudInMap {
+    core::Scan scan;
+    std::vector<openvdb::Coord> voxels;
+};
+
+CloudInMap ReadCloud(const fs::path& file, const core::VoxelMap& frame) {
+    io::ReadOptions read;
+    read.origin = frame.origin;
+    CloudInMap cloud{io::ReadPointCloud(file, read), {}};
+    for (Eigen::Vector3d& p : cloud.scan.points) {
+        p = cloud.scan.T_world_sensor * p;
+        cloud.voxels.push_back(frame.WorldToVoxel(p));
+    }
+    return cloud;
+}
+
+bool Occupied(const core::VoxelMap& map, const openvdb::Coord& ijk) {
+    return map.occupancy->tree().getValue(ijk) > 0.0F;
+}
+
+// The points `kept` marks, in the world frame, as WritePcd takes them.
+void WriteKept(const CloudInMap& cloud, const std::vector<bool>& kept, const core::VoxelMap& frame,
+               const fs::path& source, const fs::path& out) {
+    io::PcdPoints pcd;
+    pcd.origin_is_zero = frame.origin.isZero();
+    for (size_t i = 0; i < cloud.scan.points.size(); ++i) {
+        if (!kept[i]) continue;
+        pcd.points.push_back(cloud.scan.points[i] + frame.origin);
+        pcd.intensity.push_back(cloud.scan.intensity.empty() ? 0.0F : cloud.scan.intensity[i]);
+    }
+    io::WritePcd(
+        pcd,
+        "strata: the points of " + source.filename().string() + " whose voxel the map has occupied",
+        out);
+}
+
+}  // namespace
 
 std::string ExportMap(const core::VoxelMap& map, const std::filesystem::path& out,
                       const ExportOptions& options) {
@@ -55,6 +109,14 @@ std::string ExportMap(const core::VoxelMap& map, const std::filesystem::path& ou
         io::WriteOctomap(map, out);
     } else if (format == "ply") {
         io::WritePly(map, out);
+    } else if (format == "pcd" && !options.points.empty()) {
+        const CloudInMap cloud = ReadCloud(options.points, map);
+        std::vector<bool> kept(cloud.voxels.size());
+        for (size_t i = 0; i < kept.size(); ++i) kept[i] = Occupied(map, cloud.voxels[i]);
+        WriteKept(cloud, kept, map, options.points, out);
+    } else if (format == "pcd") {
+        io::WritePcd(
+            map, [&](const std::function<void(const core::VoxelMap&)>& visit) { visit(map); }, out);
     } else {
         io::TopDownOptions png;
         png.pixels_per_voxel = options.pixels_per_voxel;
@@ -67,8 +129,6 @@ std::string ExportMap(const core::VoxelMap& map, const std::filesystem::path& ou
 }
 
 namespace {
-
-namespace fs = std::filesystem;
 
 // `dir/city.vdb` -> `dir/city.X_Y.vdb`.
 fs::path TileFile(const fs::path& out, const store::TileKey& key) {
@@ -117,17 +177,41 @@ ExportResult ExportStored(const store::MapStore& map, const store::Snapshot& sna
     // Nothing cached: each tile is read, written out and dropped.
     const store::TileReader reader(map, snapshot, 0);
     if (options.split) return ExportSplit(map, reader, out, options, format);
-    if (format == "ply") {
+    if (format == "pcd" && !options.points.empty()) {
+        // Each tile read once: the points sorted by tile, looked up tile after tile.
+        const core::VoxelMap frame = map.EmptyMap();
+        const CloudInMap cloud = ReadCloud(options.points, frame);
+        std::vector<std::pair<store::TileKey, size_t>> order;
+        for (size_t i = 0; i < cloud.voxels.size(); ++i) {
+            order.emplace_back(map.settings().TileOf(cloud.voxels[i]), i);
+        }
+        std::sort(order.begin(), order.end());
+        std::vector<bool> kept(cloud.voxels.size(), false);
+        ExportResult result{format, {out}, 0};
+        for (size_t b = 0; b < order.size();) {
+            size_t e = b;
+            while (e < order.size() && order[e].first == order[b].first) ++e;
+            if (const auto tile = reader.Fused(order[b].first)) {
+                ++result.tiles_read;
+                for (size_t k = b; k < e; ++k) {
+                    kept[order[k].second] = Occupied(*tile, cloud.voxels[order[k].second]);
+                }
+            }
+            b = e;
+        }
+        WriteKept(cloud, kept, frame, options.points, out);
+        return result;
+    }
+    if (format == "ply" || format == "pcd") {
         ExportResult result{format, {out}, 0};
         const std::vector<store::TileKey> keys = reader.Tiles();
-        io::WritePly(
-            map.EmptyMap(),
-            [&](const std::function<void(const core::VoxelMap&)>& visit) {
-                for (const store::TileKey& key : keys) {
-                    if (const auto tile = reader.Fused(key)) visit(*tile);
-                }
-            },
-            out);
+        const io::MapParts parts = [&](const std::function<void(const core::VoxelMap&)>& visit) {
+            for (const store::TileKey& key : keys) {
+                if (const auto tile = reader.Fused(key)) visit(*tile);
+            }
+        };
+        format == "ply" ? io::WritePly(map.EmptyMap(), parts, out)
+                        : io::WritePcd(map.EmptyMap(), parts, out);
         result.tiles_read = 2 * keys.size();
         return result;
     }

@@ -56,7 +56,7 @@ def test_as_of_shows_the_map_right_after_a_session(tmp_path, demo_scans):
 
 
 # Every format whose bytes depend only on the map (a .vdb file carries a random UUID of its own).
-@pytest.mark.parametrize("fmt", ["ply", "png", "bt", "ot"])
+@pytest.mark.parametrize("fmt", ["ply", "pcd", "png", "bt", "ot"])
 def test_export_of_a_stored_map_equals_the_program_export(tmp_path, demo_scans, fmt):
     from conftest import run_strata
     with strata.Map.create(tmp_path / "map", voxel=0.2) as m:
@@ -67,6 +67,40 @@ def test_export_of_a_stored_map_equals_the_program_export(tmp_path, demo_scans, 
     ours = (tmp_path / f"ours.{fmt}").read_bytes()
     assert len(ours) > 100
     assert ours == (tmp_path / f"theirs.{fmt}").read_bytes()
+
+
+def read_pcd(path):
+    """x y z intensity of a binary PCD file that strata wrote (float32 fields)."""
+    data = path.read_bytes()
+    end = data.index(b"DATA binary\n") + len(b"DATA binary\n")
+    assert b"FIELDS x y z intensity" in data[:end]
+    return np.frombuffer(data[end:], dtype=np.dtype("<f4")).reshape(-1, 4)
+
+
+def test_export_of_a_clouds_points_keeps_those_in_occupied_voxels(tmp_path, demo_scans):
+    """The dynamic-map benchmark's output format: the points of a given cloud whose voxel the
+    map has occupied, as Map.occupancy answers for them, in the cloud's order."""
+    scan = demo_scans[0]
+    world = scan.points.astype(np.float64) @ scan.pose[:3, :3].T + scan.pose[:3, 3]
+    cloud = np.vstack([world, world + [0.0, 0.0, 1000.0]])  # the copy lies outside the map
+    ply = tmp_path / "cloud.ply"
+    with open(ply, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\n"
+                "property double y\nproperty double z\nproperty float intensity\n"
+                "end_header\n" % len(cloud))
+        for i, p in enumerate(cloud):
+            f.write("%.17g %.17g %.17g %d\n" % (p[0], p[1], p[2], i))
+    with strata.Map.create(tmp_path / "map", voxel=0.2) as m:
+        with m.session() as s:
+            integrate(s, demo_scans)
+        assert m.export(tmp_path / "kept.pcd", points=ply) == "pcd"
+        occupied = m.occupancy(cloud)["state"] == 1
+        with pytest.raises(strata.InvalidArgumentError, match="written as pcd"):
+            m.export(tmp_path / "kept.ply", points=ply)
+    kept = read_pcd(tmp_path / "kept.pcd")
+    assert 0.5 * len(world) < len(kept) < len(world)  # some endpoints ended free
+    np.testing.assert_array_equal(kept[:, 3], np.flatnonzero(occupied).astype(np.float32))
+    np.testing.assert_allclose(kept[:, :3], cloud[occupied], atol=1e-4)  # float32 at < 100 m
 
 
 def test_open_errors_have_their_kinds(tmp_path, demo_scans):

@@ -1,4 +1,4 @@
-// strata export: a map to the files viewers open (VDB, OctoMap .bt/.ot, PLY, PNG).
+// strata export: a map to the files viewers open (VDB, OctoMap .bt/.ot, PLY, PCD, PNG).
 #include "strata/pipeline/Export.hpp"
 
 #include <filesystem>
@@ -16,6 +16,7 @@ struct ExportArgs {
     std::string map;
     std::string format;
     std::string out;
+    std::string points;
     int pixels_per_voxel = 2;
     std::string color = "auto";
     std::string as_of;
@@ -26,6 +27,7 @@ struct ExportArgs {
 void Run(const ExportArgs& args) {
     pipeline::ExportOptions options;
     options.format = args.format;
+    options.points = args.points;
     options.pixels_per_voxel = args.pixels_per_voxel;
     options.color = args.color;
     options.memory_budget_bytes = static_cast<size_t>(args.memory_budget_mb * 1e6);
@@ -50,17 +52,23 @@ void Run(const ExportArgs& args) {
 void RegisterExport(CLI::App& app) {
     auto args = std::make_shared<ExportArgs>();
     CLI::App* cmd =
-        app.add_subcommand("export", "Export a map for viewers (VDB, OctoMap, PLY, PNG)");
+        app.add_subcommand("export", "Export a map for viewers (VDB, OctoMap, PLY, PCD, PNG)");
     cmd->footer(
         "Examples:\n"
         "  strata export city.strata --out city.vdb          # vdb_print, vdb_view, Blender\n"
         "  strata export city.strata --format ot --out city.ot  # octovis, ROS (class colours)\n"
         "  strata export city.strata --out city.png           # top-down picture\n"
-        "  strata export city.strata --out city.vdb --split  # one file per tile + index");
+        "  strata export city.strata --out city.vdb --split  # one file per tile + index\n"
+        "  strata export city.strata --out strata_output.pcd --points raw_map.pcd\n"
+        "        # the raw map's points the (static) map keeps: the dynamic-map benchmark's "
+        "format");
     cmd->add_option("MAP", args->map, "Map directory")->required();
-    cmd->add_option("--format", args->format, "vdb, bt, ot, ply or png (default: from --out)")
-        ->check(CLI::IsMember({"vdb", "bt", "ot", "ply", "png"}));
+    cmd->add_option("--format", args->format, "vdb, bt, ot, ply, pcd or png (default: from --out)")
+        ->check(CLI::IsMember({"vdb", "bt", "ot", "ply", "pcd", "png"}));
     cmd->add_option("--out", args->out, "Output file")->required();
+    cmd->add_option("--points", args->points,
+                    "pcd: instead of voxel centres, the points of this cloud (PCD, PLY, LAS, "
+                    "...; world frame) whose voxel the map has occupied (docs/dynamic.md)");
     cmd->add_option("--pixels-per-voxel", args->pixels_per_voxel, "PNG scale")
         ->capture_default_str();
     cmd->add_option("--color", args->color,
@@ -71,7 +79,7 @@ void RegisterExport(CLI::App& app) {
     cmd->add_option("--as-of", args->as_of, "Export the map as it was right after this session");
     cmd->add_option("--memory-budget", args->memory_budget_mb,
                     "MB: a larger map is refused for one vdb/bt/ot/png file (use --split); PLY "
-                    "streams tile by tile")
+                    "and PCD stream tile by tile")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     cmd->add_flag("--split", args->split,
