@@ -21,15 +21,6 @@ constexpr double kPi = 3.14159265358979323846;
 // lane-marking.
 const std::set<uint16_t> kGroundLabels = {40, 44, 48, 49, 60};
 
-vehicles::OrientedRect Footprint(const sim::BoxTruth& b) {
-    vehicles::OrientedRect r;
-    r.center = b.center.head<2>();
-    r.length = b.size.x();
-    r.width = b.size.y();
-    r.yaw_rad = b.yaw_deg * kPi / 180.0;
-    return r;
-}
-
 bool InPolygon(const std::vector<Eigen::Vector3d>& poly, const Eigen::Vector2d& p) {
     bool inside = false;
     for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
@@ -86,6 +77,15 @@ ParkingCase SimulateParking(const fs::path& scene_file, const fs::path& work_dir
         if (keep) c.reference.push_back(sample.points[i]);
     }
     return c;
+}
+
+vehicles::OrientedRect Footprint(const sim::BoxTruth& b) {
+    vehicles::OrientedRect r;
+    r.center = b.center.head<2>();
+    r.length = b.size.x();
+    r.width = b.size.y();
+    r.yaw_rad = b.yaw_deg * kPi / 180.0;
+    return r;
 }
 
 std::vector<Eigen::Vector3d> MapPoints(const core::VoxelMap& map) {

@@ -26,6 +26,9 @@ struct ParkingCase {
 [[nodiscard]] ParkingCase SimulateParking(const std::filesystem::path& scene_file,
                                           const std::filesystem::path& work_dir, double voxel_size);
 
+/// A truth box seen from above, as the vehicle pipeline's rectangles are.
+[[nodiscard]] vehicles::OrientedRect Footprint(const sim::BoxTruth& b);
+
 /// Occupied voxels as points: each voxel's point mean (its centre when it has none).
 [[nodiscard]] std::vector<Eigen::Vector3d> MapPoints(const core::VoxelMap& map);
 
