@@ -126,7 +126,7 @@ Returns {"points", "dropped", "clipped"} counts.)doc")
             "Voxel size, origin and voxel counts.")
         .def("export", &ExportMemoryMap, py::arg("path"), py::arg("format") = "",
              py::arg("color") = "auto",
-             "Writes the map for viewers: vdb, bt, ot, ply or png (default: from the name).")
+             "Writes the map for viewers: vdb, bt, ot, ply, pcd or png (default: from the name).")
         .def("walls", &WallsInMemory,
              R"doc(Walls and their slant angles (docs/walls.md), as `strata walls --json`
 reports them (walls, stats, config, ...) plus "voxels": center, slant_deg and wall_id of every
