@@ -149,13 +149,23 @@ DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
             result.objects.push_back(object);
         } else {
             result.scattered += group.size();
+            if (config.keep_scattered) {
+                for (const openvdb::Coord& c : group) {
+                    if (occupancy.getValue(c) > 0.0F) {
+                        --result.removed_occupied;  // stays as it was
+                    } else {
+                        result.restored->tree().setValueOn(c, true);
+                    }
+                }
+                continue;
+            }
         }
         for (const openvdb::Coord& c : group) result.removed->tree().setValueOn(c, id);
     }
     for (auto on = map.occupancy->tree().cbeginValueOn(); on; ++on) {
         if (*on > 0.0F) result.occupied += on.getVoxelCount();
     }
-    result.static_voxels = result.occupied + result.restored_voxels();
+    result.static_voxels = result.occupied + result.restored_voxels() - result.removed_occupied;
     return result;
 }
 

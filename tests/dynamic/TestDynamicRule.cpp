@@ -32,6 +32,13 @@ struct Scene {
     }
 };
 
+// The rule voxel by voxel: a lone voxel it removes stays removed (not kept as scattered).
+DynamicConfig VoxelByVoxel() {
+    DynamicConfig config;
+    config.keep_scattered = false;
+    return config;
+}
+
 bool Removed(const DynamicResult& r, const openvdb::Coord& c) {
     return r.removed->tree().isValueOn(c);
 }
@@ -45,7 +52,7 @@ TEST(DynamicRule, ErodedGroundIsRestoredAFloatingVoxelRemoved) {
     for (int x = -5; x <= 5; ++x) s.Hit({x, 0, 0}, -0.5F);  // ground the grazing rays eroded
     s.Hit({0, 0, 3}, -1.0F);                                // something that passed, in the air
     s.Hit({2, 2, 3}, 2.0F);                                 // occupied now: never touched
-    const DynamicResult r = FindDynamic(s.map, s.seen, DynamicConfig{});
+    const DynamicResult r = FindDynamic(s.map, s.seen, VoxelByVoxel());
     for (int x = -5; x <= 5; ++x) EXPECT_TRUE(Restored(r, {x, 0, 0})) << x;
     EXPECT_TRUE(Removed(r, {0, 0, 3}));
     EXPECT_FALSE(Removed(r, {2, 2, 3}) || Restored(r, {2, 2, 3}));
@@ -60,7 +67,7 @@ TEST(DynamicRule, TheMarginDecidesAtTheEdgeOfTheSeenSpace) {
     s.Cross({0, 0, 0}, {4, 4, 4});
     s.Hit({1, 1, 1}, -1.0F);  // every face neighbour crossed, so is the cube
     s.Hit({0, 2, 2}, -1.0F);  // at the edge: its -x neighbour was never crossed
-    DynamicConfig faces;
+    DynamicConfig faces = VoxelByVoxel();
     faces.neighbourhood = Neighbourhood::kFaces;
     const DynamicResult r = FindDynamic(s.map, s.seen, faces);
     EXPECT_TRUE(Removed(r, {1, 1, 1}));
@@ -75,7 +82,7 @@ TEST(DynamicRule, TheMarginDecidesAtTheEdgeOfTheSeenSpace) {
     s.seen.crossed->tree().setValueOff({2, 2, 2});
     s.map.occupancy->tree().setValueOn({2, 2, 2}, 1.0F);
     EXPECT_TRUE(Removed(FindDynamic(s.map, s.seen, faces), {1, 1, 1}));
-    DynamicConfig cube;
+    DynamicConfig cube = VoxelByVoxel();
     cube.neighbourhood = Neighbourhood::kCube;
     EXPECT_TRUE(Restored(FindDynamic(s.map, s.seen, cube), {1, 1, 1}));
 }
@@ -101,13 +108,37 @@ TEST(DynamicRule, TouchingVoxelsAreOneObjectSmallOnesScattered) {
     EXPECT_EQ(r.removed->tree().getValue({3, 0, 0}), 1);
 }
 
+TEST(DynamicRule, KeptScatteredGroupsStayStaticAndAreCountedOnce) {
+    Scene s;
+    s.Cross({-20, -20, -20}, {20, 20, 20});
+    for (int x = 0; x < 10; ++x) s.Hit({x, 0, 0}, -1.0F);  // a trail: removed
+    s.Hit({-10, -10, -10}, -1.0F);                         // alone and free: restored
+    s.Hit({10, 10, 10}, 1.5F);                             // alone and occupied: as it was
+    DynamicConfig config;
+    config.occupied_too = true;
+    config.keep_scattered = true;
+    const DynamicResult r = FindDynamic(s.map, s.seen, config);
+    ASSERT_EQ(r.objects.size(), 1u);
+    EXPECT_EQ(r.removed_voxels(), 10u);
+    EXPECT_EQ(r.scattered, 2u);
+    EXPECT_TRUE(Restored(r, {-10, -10, -10}));
+    EXPECT_FALSE(Removed(r, {10, 10, 10}) || Restored(r, {10, 10, 10}));
+    EXPECT_EQ(r.removed_occupied, 0u);
+    EXPECT_EQ(r.static_voxels, 2u);  // the occupied voxel and the restored one
+    config.keep_scattered = false;   // removed, the occupied one too
+    const DynamicResult all = FindDynamic(s.map, s.seen, config);
+    EXPECT_EQ(all.removed_voxels(), 12u);
+    EXPECT_EQ(all.removed_occupied, 1u);
+    EXPECT_EQ(all.static_voxels, 0u);
+}
+
 TEST(DynamicRule, TheStaticMapKeepsRestoredVoxelsAndMarksRemovedOnes) {
     Scene s;
     s.Cross({-5, -5, 1}, {5, 5, 6});
     s.Hit({0, 0, 0}, -0.5F);
     s.Hit({0, 0, 3}, -1.0F);
     s.map.endpoints->tree().setValueOn({0, 0, 3}, 7);
-    const DynamicConfig config;
+    const DynamicConfig config = VoxelByVoxel();
     const DynamicResult r = FindDynamic(s.map, s.seen, config);
     ApplyDynamic(r, config, s.map);
     EXPECT_FLOAT_EQ(s.map.occupancy->tree().getValue({0, 0, 0}), config.restored_log_odds);

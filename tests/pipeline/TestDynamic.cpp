@@ -25,8 +25,9 @@ constexpr double kSensorHeight = 1.8;
 constexpr double kFacadeY = 8.0;
 constexpr double kFacadeHeight = 6.0;
 // Tolerances, at most 3x the losses measured (in the tests).
-constexpr double kMinStaticKept = 0.999;      // SA (measured 1.0000)
-constexpr double kMinDynamicRemoved = 0.97;   // DA (measured 0.9886)
+constexpr double kMinStaticKept = 0.999;  // SA (measured 1.0000)
+constexpr double kMinDynamicRemoved =
+    0.97;  // DA (measured 0.9878; 0.9886 removing scattered voxels)
 constexpr double kMaxStaticRemoved = 0.0003;  // of the occupied voxels (measured 0)
 
 // One scan of the street: points in the sensor frame, and which of them hit the box.
@@ -155,7 +156,7 @@ TEST(PipelineDynamic, ACarDrivingPastIsRemovedAndTheErodedGroundKept) {
         before.static_accuracy, before.dynamic_accuracy, after.static_accuracy,
         after.dynamic_accuracy, outcome.result.objects.size(), outcome.result.removed_voxels(),
         outcome.result.restored_voxels());
-    // Measured 2026-12-06: SA 0.8495 -> 1.0000, DA 0.9999 -> 0.9886; four objects, all in the
+    // Measured 2026-12-06: SA 0.8495 -> 1.0000, DA 0.9999 -> 0.9878; four objects, all in the
     // car's lane, the largest most of the removed voxels.
     EXPECT_GE(after.static_accuracy, kMinStaticKept);
     EXPECT_GE(after.dynamic_accuracy, kMinDynamicRemoved);

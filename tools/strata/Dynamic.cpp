@@ -23,12 +23,14 @@ struct DynamicArgs {
     std::string png;
     std::string vdb;
     bool no_save = false;
+    bool remove_scattered = false;
 };
 
 void PrintSummary(const pipeline::DynamicOutcome& outcome, const store::MapStore& map) {
     const dynamic::DynamicResult& r = outcome.result;
     std::cout << map.dir().string() << ": " << r.objects.size() << " moving objects, "
-              << r.removed_voxels() << " voxels removed (" << r.scattered << " scattered), "
+              << r.removed_voxels() << " voxels removed, " << r.scattered << " scattered ("
+              << (outcome.config.keep_scattered ? "kept" : "removed") << "), "
               << r.restored_voxels() << " eroded static voxels kept; " << r.occupied
               << " occupied before, " << r.static_voxels << " in the static map\n";
     if (r.objects.empty()) return;
@@ -48,6 +50,7 @@ void PrintSummary(const pipeline::DynamicOutcome& outcome, const store::MapStore
 void Run(DynamicArgs& args) {
     args.config.neighbourhood =
         args.faces ? dynamic::Neighbourhood::kFaces : dynamic::Neighbourhood::kCube;
+    args.config.keep_scattered = !args.remove_scattered;
     args.config.Validate();
     const bool save = !args.no_save && args.as_of.empty();
     store::MapStore map = pipeline::OpenMap(
@@ -110,8 +113,11 @@ void RegisterDynamic(CLI::App& app) {
                   "Also judge voxels the map says are occupied (things that stopped, or were "
                   "still there at the end)");
     cmd->add_option("--min-object", c.min_object_voxels,
-                    "Smallest object reported (voxels); smaller ones are removed as scattered")
+                    "Smallest object (voxels); smaller groups are scattered voxels, kept as "
+                    "static (thin or porous things)")
         ->capture_default_str();
+    cmd->add_flag("--remove-scattered", args->remove_scattered,
+                  "Remove the scattered voxels too (removes more of trees and poles)");
     cmd->callback([args] { Run(*args); });
 }
 

@@ -43,10 +43,13 @@ struct DynamicConfig {
     /// when the recording ended.
     bool occupied_too = false;
     /// Removed voxels this near each other (in voxels along every axis; 1: touching) make one
-    /// object: a moving thing's trail, whose slices a scan apart need not touch. Objects of fewer
-    /// than min_object_voxels are removed all the same but reported only as scattered voxels.
+    /// object: a moving thing's trail, whose slices a scan apart need not touch. Groups of fewer
+    /// than min_object_voxels are scattered voxels: kept as static (restored where the map says
+    /// free), since a moving thing leaves a trail and a thin or porous static thing (leaves, a
+    /// pole) a few voxels seen through all round; removed all the same without keep_scattered.
     int object_gap_voxels = 2;
     size_t min_object_voxels = 8;
+    bool keep_scattered = true;
     /// Occupancy the static map gives an eroded static voxel (log-odds of one hit, p = 0.7),
     /// and a removed voxel the map said was occupied (of one miss, p = 0.4).
     float restored_log_odds = 0.85F;
@@ -70,8 +73,8 @@ struct DynamicResult {
     std::vector<MovingObject> objects;  ///< by id
     size_t candidates = 0;  ///< points ended there and the map says free (or any: occupied_too)
     size_t removed_occupied = 0;  ///< of the removed, those the map said were occupied
-    size_t scattered = 0;         ///< removed, in objects below min_object_voxels
-    size_t occupied = 0;          ///< occupied in the map before
+    size_t scattered = 0;  ///< in groups below min_object_voxels: removed, or kept (keep_scattered)
+    size_t occupied = 0;   ///< occupied in the map before
     /// Occupied in the static map: occupied + restored - removed_occupied.
     size_t static_voxels = 0;
 
