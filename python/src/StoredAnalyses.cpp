@@ -166,11 +166,14 @@ py::dict Vehicles(const StoredMap& m, const std::string& as_of, const std::strin
 }
 
 py::dict Dynamic(const StoredMap& m, const std::string& as_of, const std::string& session,
-                 int margin, bool faces, size_t min_object, bool save) {
+                 int margin, bool faces, size_t min_object, bool occupied_too,
+                 bool remove_scattered, bool save) {
     dynamic::DynamicConfig config;
     config.margin_voxels = margin;
     config.neighbourhood = faces ? dynamic::Neighbourhood::kFaces : dynamic::Neighbourhood::kCube;
     config.min_object_voxels = min_object;
+    config.occupied_too = occupied_too;
+    config.keep_scattered = !remove_scattered;
     MapStore& store = m.Get();
     if (save) CheckSave(store, as_of, "static map");
     auto outcome = std::make_shared<pipeline::DynamicOutcome>();
@@ -240,7 +243,8 @@ void AddStoredAnalyses(py::class_<StoredMap>& cls) {
         .def("vehicles", &Vehicles, py::arg("as_of"), py::arg("source"), py::arg("ray_check"),
              py::arg("refill"), py::arg("save"))
         .def("dynamic", &Dynamic, py::arg("as_of"), py::arg("session"), py::arg("margin"),
-             py::arg("faces"), py::arg("min_object"), py::arg("save"))
+             py::arg("faces"), py::arg("min_object"), py::arg("occupied_too"),
+             py::arg("remove_scattered"), py::arg("save"))
         .def("walls", &Walls, py::arg("as_of"), py::arg("save"))
         .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
              py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),

@@ -316,11 +316,14 @@ class Map:
         return report
 
     def dynamic(self, as_of=None, session=None, margin: int = 1, faces: bool = False,
-                min_object: int = 8, save: bool = False) -> dict:
+                min_object: int = 8, occupied_too: bool = False, remove_scattered: bool = False,
+                save: bool = False) -> dict:
         """What moved taken out of the map (docs/dynamic.md), as `strata dynamic --json`
         reports it: objects [{object_id, voxels, min_x, ..., max_z, sessions}], removed_voxels,
         restored_voxels, static_voxels, ... plus "map": the static map as a read-only VoxelMap.
-        session: only what that session (id or name) saw move.
+        session: only what that session (id or name) saw move. margin, faces, min_object,
+        occupied_too and remove_scattered are the program's --margin, --faces, --min-object,
+        --occupied-too and --remove-scattered.
 
         save=False (the default) leaves the map on disk unchanged. save=True stores the result
         as `strata dynamic` does (one commit: the static map, the dynamic_removed and
@@ -329,7 +332,7 @@ class Map:
         for writing and no as_of."""
         report = self._impl.dynamic("" if as_of is None else str(as_of),
                                     "" if session is None else str(session), margin, faces,
-                                    min_object, save)
+                                    min_object, occupied_too, remove_scattered, save)
         if save:
             self._newest = None
             report["map"] = self.snapshot()

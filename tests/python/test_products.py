@@ -102,6 +102,7 @@ def test_saved_static_map_equals_what_the_program_stores(two_copies):
         static = found.pop("map").voxels(*EVERYWHERE)
         with pytest.raises(strata.InvalidArgumentError, match="margin_voxels"):
             m.dynamic(margin=-1)
+
     with strata.Map.open(theirs, read_only=True) as m:
         expected = m.snapshot().voxels(*EVERYWHERE)
     # The stored commit, after the session's that the program's report names.
@@ -111,3 +112,38 @@ def test_saved_static_map_equals_what_the_program_stores(two_copies):
     assert rows(ours, "dynamic") == rows(theirs, "dynamic")
     for key in expected:
         np.testing.assert_array_equal(static[key], expected[key], err_msg=key)
+
+
+def test_dynamic_options_are_the_programs(tmp_path):
+    """occupied_too, remove_scattered and min_object act as --occupied-too, --remove-scattered
+    and --min-object do, on a box that moved over a ground plane (a sensor at rest)."""
+    path = tmp_path / "map"
+    grid = np.arange(-12.0, 12.0, 0.1)
+    ground = np.array([[x, y, -1.6] for x in grid for y in np.arange(-4.0, 4.0, 0.1)])
+    side = np.arange(0.0, 1.0, 0.1)
+    box = np.array([[x, y, z] for x in side for y in side for z in side - 1.4])
+    with strata.Map.create(path, voxel=0.2) as m:
+        with m.session("drive") as s:
+            for k in range(10):  # the box drives past at 2 m a scan
+                s.integrate(np.vstack([ground, box + [2.0 * k - 9.0, 1.5, 0.0]]), np.eye(4))
+    with strata.Map.open(path, read_only=True) as m:
+        for options, flags in (({}, []), ({"occupied_too": True}, ["--occupied-too"]),
+                               ({"min_object": 10**6}, ["--min-object", str(10**6)]),
+                               ({"min_object": 10**6, "remove_scattered": True},
+                                ["--min-object", str(10**6), "--remove-scattered"])):
+            ours = m.dynamic(**options)
+            ours.pop("map")
+            theirs = json.loads(run_strata("dynamic", path, "--json", "--no-save",
+                                           *flags).stdout)
+            theirs.pop("map")
+            assert ours == theirs, flags
+            if not flags:
+                assert ours["removed_voxels"] > 0  # the box's trail
+                base = ours
+            elif flags[0] == "--occupied-too":
+                assert ours["removed_voxels"] > base["removed_voxels"]  # where it stopped
+            elif "--remove-scattered" in flags:
+                # every group removed: the trail and what the default kept as scattered
+                assert ours["removed_voxels"] == base["removed_voxels"] + base["scattered_voxels"]
+            else:
+                assert ours["removed_voxels"] == 0  # every group is "scattered", kept
