@@ -1,6 +1,7 @@
 # Dynamic-object removal: SA / DA / AA on simulated traffic, the raw map beside the static map,
 # and the time (docs/dynamic.md).
-add_executable(bench_dynamic ${CMAKE_CURRENT_LIST_DIR}/bench_dynamic.cpp)
+add_executable(bench_dynamic ${CMAKE_CURRENT_LIST_DIR}/bench_dynamic.cpp
+                             ${CMAKE_CURRENT_LIST_DIR}/TrafficVehicles.cpp)
 target_link_libraries(bench_dynamic PRIVATE Strata::pipeline Strata::dynamic Strata::sim
                       Strata::vehicles strata_parking_eval TBB::tbb)
 target_include_directories(bench_dynamic PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)

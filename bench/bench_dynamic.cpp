@@ -30,49 +30,20 @@
 #include "BenchSupport.hpp"
 #include "ParkingEval.hpp"
 #include "TempPath.hpp"
+#include "TrafficVehicles.hpp"
 #include "strata/pipeline/Dynamic.hpp"
 #include "strata/pipeline/NewSession.hpp"
 #include "strata/sim/KittiIds.hpp"
 #include "strata/sim/SimulateScene.hpp"
-#include "strata/sim/Traffic.hpp"
-#include "strata/vehicles/LShapeFit.hpp"
-#include "strata/vehicles/Vehicles.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using strata::bench::CheckVehicles;
 using strata::bench::CpuSeconds;
-
-// What the vehicle pipeline's geometric detector (the maps have no labels) finds in a map,
-// against the vehicles parked at the end of the scene: the scene's own and an actor that parks.
-struct VehicleCheck {
-    size_t parked = 0;
-    size_t found = 0;      ///< parked vehicles with a detection of IoU >= testing::kMatchIoU
-    size_t detected = 0;   ///< vehicles the pipeline reports
-    size_t elsewhere = 0;  ///< detections overlapping no parked vehicle
-    size_t ghosts = 0;     ///< of those, on the path of the traffic (or where it stood)
-};
-
-// Where the traffic's vehicles went: each segment of each vehicle's path, as wide as it (people
-// walk beside trees and poles, which the detector also reports).
-std::vector<strata::vehicles::OrientedRect> TrafficCorridors(
-    const strata::sim::GroundTruth& truth) {
-    std::vector<strata::vehicles::OrientedRect> corridors;
-    for (const strata::sim::ActorTruth& a : truth.actors) {
-        if (a.type == "person" || a.type == "cyclist") continue;
-        const Eigen::Vector3d size = strata::sim::ActorSize(a.type);
-        for (size_t k = 1; k < a.path.size(); ++k) {
-            const Eigen::Vector2d from = a.path[k - 1].head<2>(), to = a.path[k].head<2>();
-            strata::vehicles::OrientedRect r;
-            r.center = 0.5 * (from + to);
-            r.length = (to - from).norm() + size.x();  // the actor's length at both ends
-            r.width = size.y();
-            r.yaw_rad = std::atan2(to.y() - from.y(), to.x() - from.x());
-            corridors.push_back(r);
-        }
-    }
-    return corridors;
-}
+using strata::bench::ParkedAtEnd;
+using strata::bench::TrafficCorridors;
+using strata::bench::VehicleCheck;
 
 // Points of one SemanticKITTI class, and how many of them a map keeps (their voxel occupied).
 struct ClassCount {
@@ -212,61 +183,6 @@ void PrintClasses(const SceneScore& s) {
                     Percent(count.kept, count.points));
     }
     std::printf("\n");
-}
-
-// Where vehicles stand at the end of the session: the scene's parked vehicles, and the traffic's
-// vehicles that stay where their path ends.
-std::vector<strata::vehicles::OrientedRect> ParkedAtEnd(const strata::sim::GroundTruth& truth) {
-    std::vector<strata::vehicles::OrientedRect> parked;
-    for (const strata::sim::BoxTruth& b : truth.vehicles) {
-        parked.push_back(strata::testing::Footprint(b));
-    }
-    for (const strata::sim::ActorTruth& a : truth.actors) {
-        if (!a.after || a.type == "person" || a.type == "cyclist") continue;
-        const Eigen::Vector3d& end = a.path.back();
-        const Eigen::Vector3d& before = a.path[a.path.size() - 2];
-        const Eigen::Vector3d size = strata::sim::ActorSize(a.type);
-        strata::vehicles::OrientedRect r;
-        r.center = end.head<2>();
-        r.length = size.x();
-        r.width = size.y();
-        r.yaw_rad = std::atan2(end.y() - before.y(), end.x() - before.x());
-        parked.push_back(r);
-    }
-    return parked;
-}
-
-bool OverlapsAny(const strata::vehicles::OrientedRect& r,
-                 const std::vector<strata::vehicles::OrientedRect>& others) {
-    for (const strata::vehicles::OrientedRect& o : others) {
-        if (strata::vehicles::OverlapArea(r, o) > 0.0) return true;
-    }
-    return false;
-}
-
-VehicleCheck CheckVehicles(const std::vector<strata::vehicles::OrientedRect>& parked,
-                           const std::vector<strata::vehicles::OrientedRect>& corridors,
-                           const strata::core::VoxelMap& map,
-                           const std::vector<Eigen::Vector3d>& origins) {
-    strata::core::VoxelMap cleared = map.DeepCopy();
-    strata::vehicles::VehicleConfig config;
-    config.source = strata::vehicles::VehicleSource::kGeometric;
-    const strata::vehicles::VehicleResult result =
-        strata::vehicles::ClearVehicles(cleared, origins, config);
-    VehicleCheck check{parked.size(), 0, result.vehicles.size(), 0, 0};
-    for (const strata::vehicles::OrientedRect& p : parked) {
-        double best = 0.0;
-        for (const strata::vehicles::Vehicle& v : result.vehicles) {
-            best = std::max(best, strata::vehicles::BirdsEyeIoU(p, v.footprint));
-        }
-        check.found += best >= strata::testing::kMatchIoU ? 1 : 0;
-    }
-    for (const strata::vehicles::Vehicle& v : result.vehicles) {
-        if (OverlapsAny(v.footprint, parked)) continue;
-        ++check.elsewhere;
-        check.ghosts += OverlapsAny(v.footprint, corridors) ? 1 : 0;
-    }
-    return check;
 }
 
 // Simulates every session of the scene, integrates each as a session of a new map (without the

@@ -1,7 +1,7 @@
 #include "strata/pipeline/Export.hpp"
 
-#include <algorithm>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <ostream>
 
@@ -78,8 +78,12 @@ CloudInMap ReadCloud(const fs::path& file, const core::VoxelMap& frame) {
     return cloud;
 }
 
-bool Occupied(const core::VoxelMap& map, const openvdb::Coord& ijk) {
-    return map.occupancy->tree().getValue(ijk) > 0.0F;
+// Which of `voxels[index[k]]` are occupied in `map`: one accessor, whose cache serves the run
+// of neighbouring points a scan's order gives.
+void MarkOccupied(const core::VoxelMap& map, const std::vector<openvdb::Coord>& voxels,
+                  const std::vector<size_t>& index, std::vector<bool>& kept) {
+    const openvdb::FloatGrid::ConstAccessor occupancy = map.occupancy->getConstAccessor();
+    for (const size_t i : index) kept[i] = occupancy.getValue(voxels[i]) > 0.0F;
 }
 
 // The points `kept` marks, in the world frame, as WritePcd takes them.
@@ -111,8 +115,10 @@ std::string ExportMap(const core::VoxelMap& map, const std::filesystem::path& ou
         io::WritePly(map, out);
     } else if (format == "pcd" && !options.points.empty()) {
         const CloudInMap cloud = ReadCloud(options.points, map);
-        std::vector<bool> kept(cloud.voxels.size());
-        for (size_t i = 0; i < kept.size(); ++i) kept[i] = Occupied(map, cloud.voxels[i]);
+        std::vector<size_t> all(cloud.voxels.size());
+        for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+        std::vector<bool> kept(cloud.voxels.size(), false);
+        MarkOccupied(map, cloud.voxels, all, kept);
         WriteKept(cloud, kept, map, options.points, out);
     } else if (format == "pcd") {
         io::WritePcd(
@@ -178,26 +184,20 @@ ExportResult ExportStored(const store::MapStore& map, const store::Snapshot& sna
     const store::TileReader reader(map, snapshot, 0);
     if (options.split) return ExportSplit(map, reader, out, options, format);
     if (format == "pcd" && !options.points.empty()) {
-        // Each tile read once: the points sorted by tile, looked up tile after tile.
+        // Each tile read once: the points grouped by tile, in the cloud's order within each.
         const core::VoxelMap frame = map.EmptyMap();
         const CloudInMap cloud = ReadCloud(options.points, frame);
-        std::vector<std::pair<store::TileKey, size_t>> order;
+        std::map<store::TileKey, std::vector<size_t>> by_tile;
         for (size_t i = 0; i < cloud.voxels.size(); ++i) {
-            order.emplace_back(map.settings().TileOf(cloud.voxels[i]), i);
+            by_tile[map.settings().TileOf(cloud.voxels[i])].push_back(i);
         }
-        std::sort(order.begin(), order.end());
         std::vector<bool> kept(cloud.voxels.size(), false);
         ExportResult result{format, {out}, 0};
-        for (size_t b = 0; b < order.size();) {
-            size_t e = b;
-            while (e < order.size() && order[e].first == order[b].first) ++e;
-            if (const auto tile = reader.Fused(order[b].first)) {
-                ++result.tiles_read;
-                for (size_t k = b; k < e; ++k) {
-                    kept[order[k].second] = Occupied(*tile, cloud.voxels[order[k].second]);
-                }
-            }
-            b = e;
+        for (const auto& [key, points] : by_tile) {
+            const auto tile = reader.Fused(key);
+            if (!tile) continue;  // no map there: nothing kept
+            ++result.tiles_read;
+            MarkOccupied(*tile, cloud.voxels, points, kept);
         }
         WriteKept(cloud, kept, frame, options.points, out);
         return result;
