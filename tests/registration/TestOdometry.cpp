@@ -4,11 +4,13 @@
 // known (docs/odometry.md).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "RealData.hpp"
 #include "Sanitizer.hpp"
 #include "SimulatedDrive.hpp"
+#include "WallEval.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/Scan.hpp"
 #include "strata/core/VoxelMap.hpp"
@@ -96,67 +98,114 @@ TEST(Odometry, TheDistrictDrivesFirstSweepsRegisterFromALevelStart) {
     }
 }
 
-// The map the odometry's poses make, against the map of the true poses: the walls the slant
-// analysis finds in both (matched by centroid, the estimate's world moved onto the truth's by the
-// first sweep's two poses) lean alike. The target is 0.1 deg; measured on 2026-12-05 over
-// the first street and the first turn at 0.2 m: 24 walls from the true poses, 22 from ours, 10
-// matched, slants 0.158 deg apart on average and 0.578 at most: the target is missed
-// (docs/odometry.md). Held at about 2x what was measured.
+// The map the odometry's poses make, against the map of the true poses: each wall of the
+// simulator's scene (ground_truth.json, longer than 3 m) that the slant analysis finds in both
+// maps (the detection lying on it, as the wall accuracy tests match them) leans alike in both.
+// The estimate's world is moved onto the truth's by the first sweep's two poses before it is
+// voxelised, so both maps share one grid and differ only by the poses. The control: the true
+// poses moved by a fraction of a voxel, which changes only the voxelisation; what a wall's slant
+// moves by there is the slant analysis's own spread, not the poses'.
+// Measured on 2026-12-07 over the first street and the first turn (200 sweeps, 0.2 m): 11 of 43
+// scene walls found in both maps, slants 0.096 deg apart on average (the target: 0.1),
+// 0.081 the median, 0.275 at most; the control 0.015 the median (0.177 on a 2600-voxel wall, 6.2
+// on a wall whose parts merged otherwise), docs/odometry.md. Held at 2-3x.
 constexpr size_t kWallSweeps = 200;
 constexpr double kWallVoxelM = 0.2;
-constexpr double kWallMatchM = 1.0;
-constexpr size_t kMinMatchedWalls = 8;
-constexpr double kMaxMeanSlantDifferenceDeg = 0.35;
-constexpr double kMaxSlantDifferenceDeg = 1.2;
+constexpr size_t kMinWallsInBoth = 9;
+constexpr double kMaxMeanSlantDifferenceDeg = 0.2;
+constexpr double kMaxSlantDifferenceDeg = 0.6;
+constexpr double kMaxControlMedianDeg = 0.04;
+constexpr double kMaxTiltDeg = 0.1;  // our up off the truth's: 0.042 deg at most (2026-12-07)
+
+core::VoxelMap MapAt(const strata::test::SimulatedDrive& drive,
+                     const std::vector<Eigen::Isometry3d>& poses) {
+    core::VoxelMap map = core::VoxelMap::Create(kWallVoxelM);
+    integration::Integrator into(map, {});
+    for (size_t k = 0; k < drive.sweeps.size(); ++k) {
+        core::Scan scan;
+        scan.points = drive.sweeps[k];
+        scan.T_world_sensor = poses[k];
+        into.Integrate(scan);
+    }
+    return map;
+}
+
+// |slant in `a` - slant in `b`| of each scene wall longer than 3 m that both found.
+std::vector<double> SlantDifferences(const std::vector<strata::testing::WallMatch>& a,
+                                     const std::vector<strata::testing::WallMatch>& b) {
+    std::vector<double> out;
+    for (size_t i = 0; i < a.size(); ++i) {
+        if (a[i].truth->length() < strata::testing::kMinTruthWallLengthM) continue;
+        if (a[i].wall == nullptr || b[i].wall == nullptr) continue;
+        out.push_back(std::abs(a[i].wall->slant_deg - b[i].wall->slant_deg));
+    }
+    return out;
+}
+
+double Median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    return values.empty() ? 0.0 : values[values.size() / 2];
+}
 
 TEST(Odometry, TheMapFromItsPosesLeansAsTheTrueMap) {
     const strata::test::SimulatedDrive& drive =
         strata::test::DistrictDrive(kWallSweeps, strata::test::kCarDrive);
     Odometry odometry;
-    core::VoxelMap truth = core::VoxelMap::Create(kWallVoxelM);
-    core::VoxelMap ours = core::VoxelMap::Create(kWallVoxelM);
-    integration::Integrator into_truth(truth, {}), into_ours(ours, {});
+    std::vector<Eigen::Isometry3d> ours;
     for (size_t k = 0; k < drive.sweeps.size(); ++k) {
         const OdometryStep step = odometry.Register(drive.sweeps[k]);
         ASSERT_TRUE(step.registered) << "scan " << k << ": " << step.failure;
-        core::Scan scan;
-        scan.points = drive.sweeps[k];
-        scan.T_world_sensor = drive.truth[k];
-        into_truth.Integrate(scan);
-        scan.T_world_sensor = step.T_world_sensor;
-        into_ours.Integrate(scan);
+        ours.push_back(step.T_world_sensor);
     }
-    const walls::WallResult true_walls = walls::FindWalls(truth);
-    const walls::WallResult our_walls = walls::FindWalls(ours);
-    const Eigen::Isometry3d onto = drive.truth.front() * odometry.poses().front().inverse();
-    size_t matched = 0;
-    double worst = 0.0, sum = 0.0;
-    for (const walls::Wall& w : our_walls.walls) {
-        const Eigen::Vector3d centroid = onto * w.centroid;
-        const walls::Wall* twin = nullptr;
-        double nearest = kWallMatchM;
-        for (const walls::Wall& v : true_walls.walls) {
-            const double d = (v.centroid - centroid).norm();
-            if (d < nearest) {
-                nearest = d;
-                twin = &v;
-            }
-        }
-        if (twin == nullptr) continue;
-        const double difference = std::abs(w.slant_deg - twin->slant_deg);
-        ++matched;
-        sum += difference;
-        worst = std::max(worst, difference);
+    // Our map's up against the truth's, sweep by sweep: the levelling and the drift of roll and
+    // pitch, which would tilt every wall alike.
+    double tilt = 0.0;
+    for (size_t k = 0; k < ours.size(); ++k) {
+        const Eigen::Matrix3d ours_in_truth =
+            drive.truth[k].linear() * ours[k].linear().transpose();
+        tilt = std::max(tilt, DegreesBetween(ours_in_truth * Eigen::Vector3d::UnitZ(),
+                                             Eigen::Vector3d::UnitZ()));
     }
+    EXPECT_LT(tilt, kMaxTiltDeg);
+    const Eigen::Isometry3d onto = drive.truth.front() * ours.front().inverse();
+    for (Eigen::Isometry3d& pose : ours) pose = onto * pose;
+    Eigen::Translation3d moved(0.071, 0.033, 0.047);  // a fraction of a 0.2 m voxel each way
+    std::vector<Eigen::Isometry3d> control;
+    for (const Eigen::Isometry3d& pose : drive.truth) control.push_back(moved * pose);
+
+    const std::vector<strata::testing::TruthWall> scene =
+        strata::testing::ReadTruthWalls(drive.ground_truth);
+    std::vector<strata::testing::TruthWall> scene_moved = scene;
+    for (strata::testing::TruthWall& w : scene_moved) {
+        w.origin += moved.translation();
+        w.d -= w.normal.dot(moved.translation());
+    }
+    const core::VoxelMap truth_map = MapAt(drive, drive.truth), our_map = MapAt(drive, ours),
+                         control_map = MapAt(drive, control);
+    const walls::WallResult truth_walls = walls::FindWalls(truth_map),
+                            our_walls = walls::FindWalls(our_map),
+                            control_walls = walls::FindWalls(control_map);
+    const auto in_truth = strata::testing::MatchWalls(scene, truth_map, truth_walls);
+    const std::vector<double> differences =
+        SlantDifferences(strata::testing::MatchWalls(scene, our_map, our_walls), in_truth);
+    const std::vector<double> spread = SlantDifferences(
+        strata::testing::MatchWalls(scene_moved, control_map, control_walls), in_truth);
+    ASSERT_GE(differences.size(), kMinWallsInBoth);
+    ASSERT_FALSE(spread.empty());
+    double sum = 0.0;
+    for (const double d : differences) sum += d;
+    const double mean = sum / static_cast<double>(differences.size());
+    const double worst = *std::max_element(differences.begin(), differences.end());
     std::printf(
-        "walls: %zu from the true poses, %zu from ours, %zu matched; slant differences "
-        "%.4f deg on average, %.4f at most\n",
-        true_walls.walls.size(), our_walls.walls.size(), matched,
-        matched > 0 ? sum / static_cast<double>(matched) : 0.0, worst);
-    ::testing::Test::RecordProperty("max_slant_difference_deg", std::to_string(worst));
-    ASSERT_GE(matched, kMinMatchedWalls);
-    EXPECT_LT(sum / static_cast<double>(matched), kMaxMeanSlantDifferenceDeg);
+        "walls found in both maps: %zu; slants %.4f deg apart on average, %.4f the median, %.4f at "
+        "most; the control (true poses moved %.3f m): %zu walls, %.4f the median; our up %.4f "
+        "deg off the truth's at most\n",
+        differences.size(), mean, Median(differences), worst, moved.translation().norm(),
+        spread.size(), Median(spread), tilt);
+    ::testing::Test::RecordProperty("mean_slant_difference_deg", std::to_string(mean));
+    EXPECT_LT(mean, kMaxMeanSlantDifferenceDeg);
     EXPECT_LT(worst, kMaxSlantDifferenceDeg);
+    EXPECT_LT(Median(spread), kMaxControlMedianDeg);
 }
 
 // A corridor 4 m wide and 3 m high with nothing along it within range: every sweep sees the same

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "TempPath.hpp"
+#include "strata/sim/GroundTruth.hpp"
 #include "strata/sim/SimulateScene.hpp"
 
 namespace strata::test {
@@ -58,8 +59,10 @@ const SimulatedDrive& DistrictDrive(size_t max_scans, const DriveShape& shape) {
     sim::SimulateConfig config;
     config.max_scans = static_cast<int>(max_scans);
     config.motion = shape.motion;
-    const sim::SessionSimulation session(sim::LoadSceneSpec(file), 0, config);
+    sim::SessionSimulation session(sim::LoadSceneSpec(file), 0, config);
     SimulatedDrive& d = it->second;
+    d.ground_truth = file.parent_path() / (file.stem().string() + "_ground_truth.json");
+    sim::WriteGroundTruth(d.ground_truth, session.scene().truth);
     for (size_t k = 0; k < session.size(); ++k) {
         sim::SimulatedScan sweep = session.Sweep(k);
         if (shape.motion) {

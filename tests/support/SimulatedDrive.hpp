@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <filesystem>
 #include <vector>
 
 namespace strata::test {
@@ -31,6 +32,8 @@ struct SimulatedDrive {
     std::vector<double> stamps;                        ///< seconds, 0.1 apart
     /// With DriveShape::motion, each point's time after its sweep's stamp (seconds); else empty.
     std::vector<std::vector<float>> times;
+    /// The scene's ground_truth.json (its walls), in the frame of `truth`: written once per drive.
+    std::filesystem::path ground_truth;
     /// The sweeps before the heading first turns 5 degrees away from the first sweep's (the
     /// first street).
     [[nodiscard]] size_t Straight() const;
