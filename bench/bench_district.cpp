@@ -110,6 +110,7 @@ bool ReadingCommands(const std::string& strata, const fs::path& map_dir, const f
         {"vehicles", {strata, "vehicles", map, "--no-save", "--memory-budget", "512"}},
         {"vehicles --source geometric",
          {strata, "vehicles", map, "--no-save", "--source", "geometric", "--memory-budget", "512"}},
+        {"dynamic", {strata, "dynamic", map, "--no-save", "--memory-budget", "512"}},
     };
     std::printf(
         "\n| command (--memory-budget 512) | s | peak RSS MiB | target %.0f MiB |\n"

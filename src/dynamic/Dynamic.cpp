@@ -28,11 +28,6 @@ std::vector<openvdb::Coord> Offsets(const DynamicConfig& config) {
     return out;
 }
 
-// The candidates of one leaf of `hit`, split by whether their whole neighbourhood was crossed.
-struct LeafVerdict {
-    std::vector<openvdb::Coord> removed, restored;
-};
-
 // Groups of the removed voxels linked by steps of at most `gap` voxels along every axis, in
 // order of their first voxel.
 std::vector<std::vector<openvdb::Coord>> Groups(std::vector<openvdb::Coord> voxels, int gap) {
@@ -86,7 +81,17 @@ size_t DynamicResult::restored_voxels() const {
     return restored ? static_cast<size_t>(restored->activeVoxelCount()) : 0;
 }
 
-DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
+void VoxelVerdicts::Append(VoxelVerdicts&& part) {
+    const auto move = [](std::vector<openvdb::Coord>& to, std::vector<openvdb::Coord>& from) {
+        to.insert(to.end(), from.begin(), from.end());
+    };
+    move(removed, part.removed);
+    move(occupied, part.occupied);
+    move(restored, part.restored);
+    occupied_voxels += part.occupied_voxels;
+}
+
+VoxelVerdicts JudgeVoxels(const core::VoxelMap& map, const SeenSpace& seen,
                           const DynamicConfig& config) {
     config.Validate();
     if (!seen.crossed || !seen.hit) {
@@ -95,7 +100,7 @@ DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
     const std::vector<openvdb::Coord> offsets = Offsets(config);
     std::vector<const openvdb::MaskTree::LeafNodeType*> leaves;
     seen.hit->tree().getNodes(leaves);
-    std::vector<LeafVerdict> verdicts(leaves.size());
+    std::vector<VoxelVerdicts> parts(leaves.size());
     const openvdb::FloatTree& occupancy = map.occupancy->tree();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& range) {
         openvdb::tree::ValueAccessor<const openvdb::FloatTree> occ(occupancy);
@@ -110,40 +115,48 @@ DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
                     std::all_of(offsets.begin(), offsets.end(),
                                 [&](const auto& d) { return crossed.isValueOn(c + d); });
                 if (through) {
-                    verdicts[i].removed.push_back(c);
+                    parts[i].removed.push_back(c);
+                    if (value > 0.0F) parts[i].occupied.push_back(c);
                 } else if (value <= 0.0F) {
-                    verdicts[i].restored.push_back(c);
+                    parts[i].restored.push_back(c);
                 }
             }
         }
     });
+    VoxelVerdicts out;
+    for (VoxelVerdicts& part : parts) out.Append(std::move(part));
+    for (auto on = occupancy.cbeginValueOn(); on; ++on) {
+        if (*on > 0.0F) out.occupied_voxels += on.getVoxelCount();
+    }
+    return out;
+}
 
+DynamicResult GroupVerdicts(VoxelVerdicts verdicts, const openvdb::math::Transform& transform,
+                            double voxel_size, const DynamicConfig& config) {
+    config.Validate();
     DynamicResult result;
     result.removed = openvdb::Int32Grid::create(0);
-    result.removed->setTransform(map.occupancy->transform().copy());
+    result.removed->setTransform(transform.copy());
     result.removed->setName(grid_names::kRemoved);
     result.restored = openvdb::BoolGrid::create(false);
-    result.restored->setTransform(map.occupancy->transform().copy());
+    result.restored->setTransform(transform.copy());
     result.restored->setName(grid_names::kRestored);
-    std::vector<openvdb::Coord> removed;
-    for (const LeafVerdict& v : verdicts) {
-        removed.insert(removed.end(), v.removed.begin(), v.removed.end());
-        for (const openvdb::Coord& c : v.restored) result.restored->tree().setValueOn(c, true);
-        result.candidates += v.removed.size() + v.restored.size();
-        for (const openvdb::Coord& c : v.removed)
-            result.removed_occupied += occupancy.getValue(c) > 0.0F;
-    }
-    const double s = map.voxel_size;
+    openvdb::MaskTree occupied;
+    for (const openvdb::Coord& c : verdicts.occupied) occupied.setValueOn(c);
+    for (const openvdb::Coord& c : verdicts.restored) result.restored->tree().setValueOn(c, true);
+    result.candidates = verdicts.removed.size() + verdicts.restored.size();
+    result.removed_occupied = verdicts.occupied.size();
+    result.occupied = verdicts.occupied_voxels;
     for (std::vector<openvdb::Coord>& group :
-         Groups(std::move(removed), config.object_gap_voxels)) {
+         Groups(std::move(verdicts.removed), config.object_gap_voxels)) {
         int32_t id = 0;
         if (group.size() >= config.min_object_voxels) {
             MovingObject object;
             object.id = static_cast<int32_t>(result.objects.size() + 1);
             object.voxels = group.size();
             for (const openvdb::Coord& c : group) {
-                object.box.extend(Eigen::Vector3d(c.x(), c.y(), c.z()) * s);
-                object.box.extend(Eigen::Vector3d(c.x() + 1, c.y() + 1, c.z() + 1) * s);
+                object.box.extend(Eigen::Vector3d(c.x(), c.y(), c.z()) * voxel_size);
+                object.box.extend(Eigen::Vector3d(c.x() + 1, c.y() + 1, c.z() + 1) * voxel_size);
             }
             id = object.id;
             result.objects.push_back(object);
@@ -151,7 +164,7 @@ DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
             result.scattered += group.size();
             if (config.keep_scattered) {
                 for (const openvdb::Coord& c : group) {
-                    if (occupancy.getValue(c) > 0.0F) {
+                    if (occupied.isValueOn(c)) {
                         --result.removed_occupied;  // stays as it was
                     } else {
                         result.restored->tree().setValueOn(c, true);
@@ -162,22 +175,29 @@ DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
         }
         for (const openvdb::Coord& c : group) result.removed->tree().setValueOn(c, id);
     }
-    for (auto on = map.occupancy->tree().cbeginValueOn(); on; ++on) {
-        if (*on > 0.0F) result.occupied += on.getVoxelCount();
-    }
     result.static_voxels = result.occupied + result.restored_voxels() - result.removed_occupied;
     return result;
 }
 
-void ApplyDynamic(const DynamicResult& result, const DynamicConfig& config, core::VoxelMap& map) {
+DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
+                          const DynamicConfig& config) {
+    return GroupVerdicts(JudgeVoxels(map, seen, config), map.occupancy->transform(), map.voxel_size,
+                         config);
+}
+
+void ApplyDynamic(const DynamicResult& result, const DynamicConfig& config, core::VoxelMap& map,
+                  const openvdb::CoordBBox& region) {
     config.Validate();
     auto& occupancy = map.occupancy->tree();
     for (auto on = result.restored->tree().cbeginValueOn(); on; ++on) {
-        occupancy.setValueOn(on.getCoord(), config.restored_log_odds);
+        if (region.isInside(on.getCoord())) {
+            occupancy.setValueOn(on.getCoord(), config.restored_log_odds);
+        }
     }
     const auto dynamic = static_cast<int32_t>(core::SemanticClass::kDynamic);
     for (auto on = result.removed->tree().cbeginValueOn(); on; ++on) {
         const openvdb::Coord c = on.getCoord();
+        if (!region.isInside(c)) continue;
         if (occupancy.getValue(c) > 0.0F) occupancy.setValueOn(c, config.removed_log_odds);
         map.endpoints->tree().setValueOff(c, 0);
         map.label->tree().setValueOn(c, dynamic);

@@ -3,10 +3,15 @@
 #include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 
+#include "DynamicByTiles.hpp"
+#include "TileBudget.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/ParallelFor.hpp"
 #include "strata/pipeline/MapAccess.hpp"
+#include "strata/pipeline/RankedSession.hpp"
+#include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline {
 namespace {
@@ -35,29 +40,17 @@ std::vector<store::SessionLayer> ReadLayers(const store::MapStore& map,
     std::vector<store::SessionLayer> layers(snapshot.layers.size());
     core::ParallelFor(layers.size(),
                       [&](size_t i) { layers[i] = map.ReadLayer(snapshot.layers[i]); });
-    for (const store::SessionLayer& l : layers) {
-        if (l.crossed && l.grazed && l.hit) continue;
-        const auto s = std::find_if(snapshot.sessions.begin(), snapshot.sessions.end(),
-                                    [&](const auto& r) { return r.id == l.session; });
-        const std::string name = s == snapshot.sessions.end() ? "" : " '" + s->name + "'";
-        throw RefusedError("session " + std::to_string(l.session) + name +
-                           " was integrated before strata recorded the space its rays crossed "
-                           "(map format 6): integrate its scans again (`strata remove-session`, "
-                           "then `strata integrate`) to find what moved");
-    }
+    for (const store::SessionLayer& l : layers) detail::RequireCrossed(l, snapshot);
     return layers;
 }
 
 // Crossed by any session; hit by session `only` (0: any).
-dynamic::SeenSpace SeenFrom(const store::MapStore& map,
+dynamic::SeenSpace SeenFrom(const store::MapStore& map, const store::Snapshot& snapshot,
                             const std::vector<store::SessionLayer>& layers,
                             const std::map<int64_t, openvdb::MaskGrid::Ptr>& hits, int64_t only) {
     dynamic::SeenSpace seen{EmptyMask(map), EmptyMask(map)};
     for (const store::SessionLayer& l : layers) {
-        openvdb::MaskTree through(l.free->tree(), false, openvdb::TopologyCopy());
-        through.topologyDifference(l.grazed->tree());
-        through.topologyUnion(l.crossed->tree());
-        seen.crossed->tree().topologyUnion(through);
+        seen.crossed->tree().topologyUnion(detail::CrossedBy(l, snapshot));
     }
     for (const auto& [id, grid] : hits) {
         if (only == 0 || id == only) seen.hit->tree().topologyUnion(grid->tree());
@@ -65,26 +58,48 @@ dynamic::SeenSpace SeenFrom(const store::MapStore& map,
     return seen;
 }
 
+// The id of `session` (0 for an empty name), which must be alive in the snapshot.
+int64_t SessionOf(const store::MapStore& map, const store::Snapshot& snapshot,
+                  const std::string& session) {
+    if (session.empty()) return 0;
+    const int64_t id = map.FindSession(session);
+    const bool alive = std::any_of(snapshot.sessions.begin(), snapshot.sessions.end(),
+                                   [&](const auto& r) { return r.id == id; });
+    if (!alive) {
+        throw NotFoundError("session " + session + " is not part of the map at commit " +
+                            std::to_string(snapshot.commit));
+    }
+    return id;
+}
+
 }  // namespace
 
+bool DynamicReadsWhole(const store::MapStore& map, const store::Snapshot& snapshot, size_t budget) {
+    if (budget == 0) return true;
+    double layers = 0.0;
+    for (const store::LayerFile& l : snapshot.layers) layers += static_cast<double>(l.bytes);
+    const double fused = static_cast<double>(map.Bytes(snapshot).fused_current);
+    return fused * detail::MemoryPerFileByte(map, snapshot) +
+               layers * detail::MemoryPerLayerByte(map, snapshot) <=
+           static_cast<double>(budget);
+}
+
 DynamicOutcome FindDynamic(const store::MapStore& map, const store::Snapshot& snapshot,
-                           const dynamic::DynamicConfig& config, const std::string& session) {
+                           const dynamic::DynamicConfig& config, const std::string& session,
+                           size_t memory_budget_bytes) {
     config.Validate();
+    const int64_t only = SessionOf(map, snapshot, session);
+    if (!DynamicReadsWhole(map, snapshot, memory_budget_bytes)) {
+        return detail::FindDynamicByTiles(map, snapshot, config, only, memory_budget_bytes,
+                                          Ranks{});
+    }
     DynamicOutcome out;
     out.commit = snapshot.commit;
     out.config = config;
-    if (!session.empty()) {
-        out.session = map.FindSession(session);
-        const bool alive = std::any_of(snapshot.sessions.begin(), snapshot.sessions.end(),
-                                       [&](const auto& r) { return r.id == out.session; });
-        if (!alive) {
-            throw NotFoundError("session " + session + " is not part of the map at commit " +
-                                std::to_string(snapshot.commit));
-        }
-    }
+    out.session = only;
     const std::vector<store::SessionLayer> layers = ReadLayers(map, snapshot);
     const auto hits = HitsBySession(map, layers);
-    const dynamic::SeenSpace seen = SeenFrom(map, layers, hits, out.session);
+    const dynamic::SeenSpace seen = SeenFrom(map, snapshot, layers, hits, out.session);
     out.cleaned = map.LoadMap(snapshot);
     out.result = dynamic::FindDynamic(out.cleaned, seen, config);
     dynamic::ApplyDynamic(out.result, config, out.cleaned);
@@ -102,6 +117,19 @@ DynamicOutcome FindDynamic(const store::MapStore& map, const store::Snapshot& sn
         }
     }
     return out;
+}
+
+DynamicOutcome FindDynamicOnRanks(const store::MapStore& map, const store::Snapshot& snapshot,
+                                  const dynamic::DynamicConfig& config, const std::string& session,
+                                  size_t memory_budget_bytes, const Ranks& ranks) {
+    if (ranks.size() == 1) return FindDynamic(map, snapshot, config, session, memory_budget_bytes);
+    const store::Snapshot same = detail::SameSnapshotOnRanks(map, snapshot, ranks);
+    int64_t only = 0;
+    OnEveryRank(ranks, [&] {
+        config.Validate();
+        only = SessionOf(map, same, session);
+    });
+    return detail::FindDynamicByTiles(map, same, config, only, memory_budget_bytes, ranks);
 }
 
 std::string DynamicRow(const dynamic::MovingObject& object, const std::vector<int64_t>& sessions) {
@@ -141,7 +169,20 @@ int64_t StoreDynamic(store::MapStore& map, DynamicOutcome& outcome) {
     store::ProductCommit product;
     product.kind = "dynamic";
     product.grids = {outcome.result.removed, outcome.result.restored};
-    product.edited = &outcome.cleaned;
+    std::optional<store::TileReader> reader;
+    if (outcome.tiles == 0) {
+        product.edited = &outcome.cleaned;
+    } else {
+        // Tile by tile: each tile the result touches, read, made static and written in turn.
+        reader.emplace(map, map.Latest(), 0);
+        product.edited_tile = [&](const store::TileKey& key) {
+            const auto fused = reader->Fused(key);
+            core::VoxelMap tile = fused ? fused->DeepCopy() : map.EmptyMap();
+            dynamic::ApplyDynamic(outcome.result, outcome.config, tile,
+                                  map.settings().TileBounds(key));
+            return tile;
+        };
+    }
     for (size_t k = 0; k < outcome.result.objects.size(); ++k) {
         product.rows.push_back(DynamicRow(outcome.result.objects[k], outcome.object_sessions[k]));
     }

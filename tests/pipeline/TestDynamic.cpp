@@ -8,7 +8,9 @@
 #include <limits>
 #include <optional>
 #include <random>
+#include <set>
 
+#include "MapDiff.hpp"
 #include "PipelineTestUtil.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
@@ -99,10 +101,12 @@ std::vector<StreetScan> Street(int scans, double box_step) {
     return out;
 }
 
-fs::path Integrate(const std::string& name, const std::vector<StreetScan>& scans) {
+fs::path Integrate(const std::string& name, const std::vector<StreetScan>& scans,
+                   double tile_size_m = store::StoreSettings{}.tile_size_m) {
     const fs::path dir = Temp(name);
     store::StoreSettings settings;
     settings.voxel_size_m = kVoxel;
+    settings.tile_size_m = tile_size_m;
     store::MapStore map = store::MapStore::Create(dir, settings);
     store::SessionOptions options;
     options.name = "drive";
@@ -200,6 +204,75 @@ TEST(PipelineDynamic, AStaticStreetLosesAlmostNothing) {
     EXPECT_LT(static_cast<double>(outcome.result.removed_voxels()),
               kMaxStaticRemoved * static_cast<double>(outcome.result.occupied));
     EXPECT_GE(Score(scans, outcome.cleaned).static_accuracy, kMinStaticKept);
+}
+
+// A map larger than the memory budget is judged a tile at a time: the street in tiles of
+// 6.4 m (84 of them; the car's trail crosses several), with a budget just below what reading
+// it whole takes. What is found, and the static map stored, equal the whole map's voxel for voxel.
+TEST(PipelineDynamic, TileByTileFindsAndStoresWhatTheWholeMapDoes) {
+    const fs::path whole_dir = Integrate("dynamic_tiles_whole", Street(30, 1.0), 6.4);
+    const fs::path tiled_dir = Temp("dynamic_tiles_tiled");
+    fs::remove_all(tiled_dir);
+    fs::copy(whole_dir, tiled_dir, fs::copy_options::recursive);
+    store::MapStore whole_map = store::MapStore::Open(whole_dir, store::MapStore::Access::kWrite);
+    store::MapStore tiled_map = store::MapStore::Open(tiled_dir, store::MapStore::Access::kWrite);
+    const store::Snapshot snapshot = tiled_map.Latest();
+    size_t budget = size_t{1} << 30;
+    while (DynamicReadsWhole(tiled_map, snapshot, budget)) budget = budget * 9 / 10;
+    DynamicOutcome whole = FindDynamic(whole_map, whole_map.Latest(), dynamic::DynamicConfig{});
+    DynamicOutcome tiled = FindDynamic(tiled_map, snapshot, dynamic::DynamicConfig{}, "", budget);
+    std::printf("%zu tiles within %.2f MB; %zu objects, %zu removed, %zu restored\n", tiled.tiles,
+                static_cast<double>(budget) / 1e6, tiled.result.objects.size(),
+                tiled.result.removed_voxels(), tiled.result.restored_voxels());
+    EXPECT_EQ(whole.tiles, 0U);
+    ASSERT_GT(tiled.tiles, 50U);
+    const dynamic::DynamicResult &t = tiled.result, &w = whole.result;
+    ASSERT_GT(w.objects.size(), 0U);
+    EXPECT_EQ(t.candidates, w.candidates);
+    EXPECT_EQ(t.removed_occupied, w.removed_occupied);
+    EXPECT_EQ(t.scattered, w.scattered);
+    EXPECT_EQ(t.occupied, w.occupied);
+    EXPECT_EQ(t.static_voxels, w.static_voxels);
+    ASSERT_EQ(t.objects.size(), w.objects.size());
+    for (size_t k = 0; k < w.objects.size(); ++k) {
+        EXPECT_EQ(t.objects[k].id, w.objects[k].id);
+        EXPECT_EQ(t.objects[k].voxels, w.objects[k].voxels);
+        EXPECT_EQ(t.objects[k].box.min(), w.objects[k].box.min());
+        EXPECT_EQ(t.objects[k].box.max(), w.objects[k].box.max());
+    }
+    EXPECT_EQ(tiled.object_sessions, whole.object_sessions);
+    EXPECT_EQ(strata::testing::FirstDifference("removed", *t.removed, *w.removed), "");
+    EXPECT_EQ(strata::testing::FirstDifference("restored", *t.restored, *w.restored), "");
+    // The trail (the largest object) crosses tiles: its voxels were judged in several.
+    const auto trail =
+        std::max_element(t.objects.begin(), t.objects.end(),
+                         [](const auto& a, const auto& b) { return a.voxels < b.voxels; });
+    const store::MapSettings& settings = tiled_map.settings();
+    std::set<std::pair<int, int>> trail_tiles;
+    for (auto on = t.removed->cbeginValueOn(); on; ++on) {
+        if (*on != trail->id) continue;
+        const store::TileKey key = settings.TileOf(on.getCoord());
+        trail_tiles.insert({key.x, key.y});
+    }
+    EXPECT_GT(trail_tiles.size(), 1U);
+
+    (void)StoreDynamic(whole_map, whole);
+    (void)StoreDynamic(tiled_map, tiled);
+    EXPECT_EQ(strata::testing::MapDifference(tiled_map.LoadMap(tiled_map.Latest()),
+                                             whole_map.LoadMap(whole_map.Latest())),
+              "");
+    EXPECT_EQ(tiled_map.ProductRows("dynamic").size(), w.objects.size());
+
+    // A budget below one tile with its neighbours' layers is refused, naming the flag.
+    const MapState before = StateOf(tiled_dir, "dynamic");
+    try {
+        (void)FindDynamic(tiled_map, tiled_map.Latest(), dynamic::DynamicConfig{}, "", 1000);
+        ADD_FAILURE() << "a 1 kB budget was accepted";
+    } catch (const RefusedError& e) {
+        EXPECT_NE(std::string(e.what()).find("raise --memory-budget"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(StateOf(tiled_dir, "dynamic"), before);
 }
 
 TEST(PipelineDynamic, StoringFromAReaderOrAnUnknownSessionIsRefused) {

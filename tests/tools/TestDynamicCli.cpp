@@ -82,6 +82,13 @@ TEST(DynamicCli, BadArgumentsAndOldSessionsLeaveTheMapAsItWas) {
         FailedWith(Strata("dynamic " + map.string() + " --session nosuch"), kNotFound, "nosuch"));
     EXPECT_TRUE(FailedWith(Strata("dynamic " + map.string() + " --png /nonexistent/dir/d.png"),
                            kFailed, "/nonexistent/dir/d.png"));
+    // Beyond the memory budget the map is judged tile by tile (tests/pipeline: the same result);
+    // the picture draws the whole map, and no tile fits 1 kB.
+    EXPECT_TRUE(FailedWith(Strata("dynamic " + map.string() + " --memory-budget 0.001 --png " +
+                                  Temp("tiles.png").string()),
+                           kRefused, "--png draw the whole map"));
+    EXPECT_TRUE(FailedWith(Strata("dynamic " + map.string() + " --memory-budget 0.001"), kRefused,
+                           "raise --memory-budget"));
     EXPECT_EQ(MapFiles(map), before);
     // A session integrated before its layers recorded the crossed space (format 5).
     strata::test::RewriteAsFormat4(map);

@@ -162,10 +162,16 @@ TEST(MpiCli, WallsOnTwoAndThreeRanksAreTheOneProcessWalls) {
 
 // The vehicles report without what depends on how the map was read (time; Embree faces are
 // summed over the blocks' scenes).
-nlohmann::json VehiclesReport(const std::string& out) {
+// The JSON report in a command's output (its other lines, and mpirun's, around it).
+nlohmann::json ReportIn(const std::string& out) {
     const size_t first = out.find('{'), last = out.rfind('}');
     if (first == std::string::npos || last == std::string::npos || last < first) return {};
-    nlohmann::json j = nlohmann::json::parse(out.substr(first, last - first + 1));
+    return nlohmann::json::parse(out.substr(first, last - first + 1));
+}
+
+nlohmann::json VehiclesReport(const std::string& out) {
+    nlohmann::json j = ReportIn(out);
+    if (j.is_null()) return j;
     j.erase("seconds");
     j.erase("occluder_faces");
     return j;
@@ -199,6 +205,47 @@ TEST(MpiCli, VehiclesOnTwoAndThreeRanksAreTheOneProcessVehicles) {
         ASSERT_EQ(r.code, 0) << r.out;
         EXPECT_EQ(VehiclesReport(r.out), whole) << ranks << " ranks";
     }
+    const Result check = Strata("check " + map.string());
+    EXPECT_EQ(check.code, 0) << check.out;
+}
+
+// `strata dynamic` on ranks: each judges its share of the tiles (3.2 m: the cars' trails cross
+// them), rank 0 groups the removed voxels into objects, reports and stores: the report of one
+// process, and three ranks' stored map is the one process's voxel for voxel.
+TEST(MpiCli, DynamicOnRanksIsTheOneProcessDynamic) {
+    const fs::path seq = Temp("mpi_dynamic_seq"), map = Temp("mpi_dynamic_map"),
+                   one_map = Temp("mpi_dynamic_one");
+    const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/traffic.json";
+    ASSERT_EQ(Strata("simulate --scene " + scene + " --out " + seq.string() +
+                     " --max-scans 8 --no-picture")
+                  .code,
+              0);
+    ASSERT_EQ(
+        Strata("integrate " + map.string() + " --kitti " + seq.string() + " --tile-size 3.2").code,
+        0);
+    fs::remove_all(one_map);
+    fs::copy(map, one_map, fs::copy_options::recursive);
+    const Result one = Strata("dynamic " + one_map.string() + " --json --memory-budget 0");
+    ASSERT_EQ(one.code, 0) << one.out;
+    const nlohmann::json whole = ReportIn(one.out);
+    ASSERT_GE(whole["objects"].size(), 2u) << one.out;
+    for (int ranks : RankCounts()) {
+        // Three ranks also store the static map: rank 0 alone commits it.
+        // mpirun forwards a rank's stdout and stderr apart: the report alone on stdout.
+        const std::string save = ranks == 2 ? " --no-save" : "";
+        const fs::path err = Temp("mpi_dynamic_err.txt");
+        const Result r = Shell("{ " + std::string(kMpirun) + " -n " + std::to_string(ranks) + " " +
+                               STRATA_BINARY + " dynamic " + map.string() + save + " --json 2>" +
+                               err.string() + "; }");
+        const std::string said = ReadText(err);
+        ASSERT_EQ(r.code, 0) << r.out << said;
+        nlohmann::json report = ReportIn(r.out);
+        report["map"] = whole["map"];
+        EXPECT_EQ(report, whole) << ranks << " ranks";
+        EXPECT_NE(said.find("tiles over " + std::to_string(ranks) + " ranks"), std::string::npos)
+            << said;
+    }
+    ExpectSameStores(map, one_map);
     const Result check = Strata("check " + map.string());
     EXPECT_EQ(check.code, 0) << check.out;
 }

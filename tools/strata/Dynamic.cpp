@@ -4,6 +4,8 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "Commands.hpp"
 #include "MapAccess.hpp"
@@ -24,6 +26,7 @@ struct DynamicArgs {
     std::string vdb;
     bool no_save = false;
     bool remove_scattered = false;
+    double memory_budget_mb = 512.0;
 };
 
 void PrintSummary(const pipeline::DynamicOutcome& outcome, const store::MapStore& map) {
@@ -53,13 +56,22 @@ void Run(DynamicArgs& args) {
     args.config.keep_scattered = !args.remove_scattered;
     args.config.Validate();
     const bool save = !args.no_save && args.as_of.empty();
-    store::MapStore map = pipeline::OpenMap(
-        args.map, save ? store::MapStore::Access::kWrite : store::MapStore::Access::kRead);
-    const store::Snapshot snapshot = pipeline::SelectSnapshot(map, args.as_of);
-    pipeline::DynamicOutcome outcome =
-        pipeline::FindDynamic(map, snapshot, args.config, args.session);
+    // Under mpirun every rank judges its share of the tiles; rank 0 groups, reports and saves.
+    const pipeline::Ranks& ranks = CommandRanks();
+    MapOnRanks opened = OpenMapOnRanks(args.map, args.as_of, save, ranks);
+    store::MapStore& map = opened.map;
+    const std::optional<store::Snapshot>& snapshot = opened.snapshot;
+    const auto budget = static_cast<size_t>(args.memory_budget_mb * 1e6);
+    // The picture shows the whole map before and after: refused rather than drawn partly.
+    RefuseWholeMapOutputs(
+        map, ranks, !args.png.empty(), "--png",
+        [&] { return pipeline::DynamicReadsWhole(map, *snapshot, budget); }, args.memory_budget_mb,
+        "the moving objects, --vdb and --json");
+    pipeline::DynamicOutcome outcome = pipeline::FindDynamicOnRanks(
+        map, snapshot ? *snapshot : store::Snapshot{}, args.config, args.session, budget, ranks);
+    if (!ranks.root()) return;
     if (!args.png.empty()) {
-        dynamic::WriteDynamicPng(map.LoadMap(snapshot), outcome.cleaned, outcome.result, args.png);
+        dynamic::WriteDynamicPng(map.LoadMap(*snapshot), outcome.cleaned, outcome.result, args.png);
     }
     if (!args.vdb.empty()) {
         WriteGridsFile({outcome.result.removed, outcome.result.restored}, args.vdb);
@@ -68,6 +80,11 @@ void Run(DynamicArgs& args) {
         std::cout << pipeline::DynamicReport(outcome, map) << "\n";
     } else {
         PrintSummary(outcome, map);
+    }
+    if (outcome.tiles > 0) {
+        (args.json ? std::cerr : std::cout)
+            << "read tile by tile within --memory-budget: " << outcome.tiles << " tiles"
+            << (ranks.size() > 1 ? " over " + std::to_string(ranks.size()) + " ranks" : "") << "\n";
     }
     if (save) {
         const size_t objects = outcome.result.objects.size();
@@ -90,6 +107,7 @@ void RegisterDynamic(CLI::App& app) {
         "Examples:\n"
         "  strata dynamic street.strata --png dynamic.png\n"
         "  strata dynamic street.strata --json --no-save\n"
+        "  mpirun -n 2 strata dynamic district.strata --memory-budget 256   # tile by tile\n"
         "Stores the static map (one commit; --as-of the last session shows the map before),\n"
         "the dynamic_removed and dynamic_restored grids and the dynamic table, unless --no-save\n"
         "or --as-of is given. docs/dynamic.md explains the rule and its accuracy.");
@@ -103,6 +121,11 @@ void RegisterDynamic(CLI::App& app) {
     cmd->add_option("--vdb", args->vdb,
                     "Write the dynamic_removed and dynamic_restored grids to a .vdb file");
     cmd->add_flag("--no-save", args->no_save, "Do not store the static map");
+    cmd->add_option("--memory-budget", args->memory_budget_mb,
+                    "MB: a map whose fused grids and session layers exceed it is judged a tile "
+                    "at a time (the same result); 0: read whole")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     cmd->add_option("--margin", c.margin_voxels,
                     "Voxels around a seen-through voxel that must have been crossed too")
         ->capture_default_str();

@@ -52,10 +52,11 @@ void PrintProfile(const pipeline::IntegrateResult& r) {
 }
 
 // --remove-dynamic: what moved taken out of the map just committed, as `strata dynamic` does (its
-// own commit after the session's).
-void RemoveDynamic(const std::string& dir) {
+// own commit after the session's), tile by tile beyond --memory-budget.
+void RemoveDynamic(const std::string& dir, double memory_budget_mb) {
     store::MapStore map = pipeline::OpenMap(dir, store::MapStore::Access::kWrite);
-    pipeline::DynamicOutcome outcome = pipeline::FindDynamic(map, map.Latest(), {});
+    pipeline::DynamicOutcome outcome = pipeline::FindDynamic(
+        map, map.Latest(), {}, "", static_cast<size_t>(memory_budget_mb * 1e6));
     const dynamic::DynamicResult& found = outcome.result;
     std::cout << "dynamic: " << found.objects.size() << " moving objects, "
               << found.removed_voxels() << " voxels removed, " << found.restored_voxels()
@@ -151,7 +152,8 @@ void Run(const IntegrateArgs& args, const CLI::App& cmd) {
               << " MB), commit " << r.stats.commit_seconds << " s; map has " << r.map_tiles
               << " tiles\n";
     if (args.profile && CommandRanks().size() == 1) PrintProfile(r);
-    if (args.remove_dynamic && CommandRanks().root()) RemoveDynamic(args.map);
+    if (args.remove_dynamic && CommandRanks().root())
+        RemoveDynamic(args.map, args.memory_budget_mb);
     if (CommandRanks().size() > 1) {
         std::cout << "rank 0 of " << CommandRanks().size() << ": " << r.steps.cast
                   << " s reading and casting its scans, " << r.steps.exchange

@@ -53,7 +53,8 @@ void KeepFreedMemory() {
 bool SharesWork(int argc, char** argv) {
     if (argc < 2) return false;
     const std::string command = argv[1];
-    return command == "integrate" || command == "walls" || command == "vehicles";
+    return command == "integrate" || command == "walls" || command == "vehicles" ||
+           command == "dynamic";
 }
 
 // Swallows std::cout and std::cerr while it lives: the output of the ranks other than 0 (rank 0

@@ -84,15 +84,42 @@ struct DynamicResult {
     [[nodiscard]] size_t restored_voxels() const;
 };
 
+/// @brief The voxel-by-voxel half of FindDynamic, over the whole map or a part of it (a tile,
+/// with the space crossed around it): each candidate seen through or not, before the removed
+/// voxels are grouped into objects. Parts' verdicts append.
+struct VoxelVerdicts {
+    std::vector<openvdb::Coord> removed;   ///< seen through
+    std::vector<openvdb::Coord> occupied;  ///< of the removed, those the map says are occupied
+    std::vector<openvdb::Coord> restored;  ///< eroded static voxels the static map keeps
+    size_t occupied_voxels = 0;            ///< occupied in the part's map
+
+    void Append(VoxelVerdicts&& part);
+};
+
+/// @brief Judges the voxels of `seen.hit` that `map` holds (docs/dynamic.md, "The rule");
+/// `seen.crossed` must cover them and `margin_voxels` around. Parallel (TBB).
+/// @throw InvalidArgumentError for a bad config or `seen` without both grids.
+[[nodiscard]] VoxelVerdicts JudgeVoxels(const core::VoxelMap& map, const SeenSpace& seen,
+                                        const DynamicConfig& config);
+
+/// @brief The objects of the removed voxels (every part's verdicts appended), the scattered ones
+/// kept or removed, as grids in `transform` (the map's, voxels of `voxel_size` metres).
+[[nodiscard]] DynamicResult GroupVerdicts(VoxelVerdicts verdicts,
+                                          const openvdb::math::Transform& transform,
+                                          double voxel_size, const DynamicConfig& config);
+
 /// @brief Finds the voxels that held moving things in `map` (its fused grids) from what the
-/// sessions' rays did (docs/dynamic.md). Parallel (TBB); the map is not changed.
+/// sessions' rays did (docs/dynamic.md): JudgeVoxels, then GroupVerdicts. The map is not
+/// changed.
 /// @throw InvalidArgumentError for a bad config or `seen` without both grids.
 [[nodiscard]] DynamicResult FindDynamic(const core::VoxelMap& map, const SeenSpace& seen,
                                         const DynamicConfig& config);
 
 /// @brief Makes `map` the static map: restored voxels occupied (config.restored_log_odds),
 /// removed voxels without their endpoints and, where the map keeps labels, of class kDynamic.
-/// Occupancy of removed voxels stays as it was (free).
-void ApplyDynamic(const DynamicResult& result, const DynamicConfig& config, core::VoxelMap& map);
+/// Occupancy of removed voxels stays as it was (free). Only the voxels within `region` change
+/// (a tile of a map edited tile by tile).
+void ApplyDynamic(const DynamicResult& result, const DynamicConfig& config, core::VoxelMap& map,
+                  const openvdb::CoordBBox& region = openvdb::CoordBBox::inf());
 
 }  // namespace strata::dynamic
