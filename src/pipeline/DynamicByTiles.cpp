@@ -49,44 +49,6 @@ void GatherOnRoot(const Ranks& ranks, dynamic::VoxelVerdicts& verdicts, HitBy& h
     }
 }
 
-}  // namespace
-
-double MemoryPerLayerByte(const store::MapStore& map, const store::Snapshot& snapshot) {
-    const auto largest = std::max_element(
-        snapshot.layers.begin(), snapshot.layers.end(),
-        [](const store::LayerFile& a, const store::LayerFile& b) { return a.bytes < b.bytes; });
-    if (largest == snapshot.layers.end() || largest->bytes == 0) return 1.0;
-    const store::SessionLayer layer = map.ReadLayer(*largest);
-    size_t memory = 0;
-    for (const auto* grid :
-         {&layer.occupied, &layer.free, &layer.crossed, &layer.grazed, &layer.hit}) {
-        if (*grid) memory += (*grid)->memUsage();
-    }
-    return std::max(1.0, static_cast<double>(memory) / static_cast<double>(largest->bytes));
-}
-
-void RequireCrossed(const store::SessionLayer& layer, const store::Snapshot& snapshot) {
-    if (!layer.crossed || !layer.grazed || !layer.hit) {
-        const auto s = std::find_if(snapshot.sessions.begin(), snapshot.sessions.end(),
-                                    [&](const auto& r) { return r.id == layer.session; });
-        const std::string name = s == snapshot.sessions.end() ? "" : " '" + s->name + "'";
-        throw RefusedError("session " + std::to_string(layer.session) + name +
-                           " was integrated before strata recorded the space its rays crossed "
-                           "(map format 6): integrate its scans again (`strata remove-session`, "
-                           "then `strata integrate`) to find what moved");
-    }
-}
-
-openvdb::MaskTree CrossedBy(const store::SessionLayer& layer, const store::Snapshot& snapshot) {
-    RequireCrossed(layer, snapshot);
-    openvdb::MaskTree through(layer.free->tree(), false, openvdb::TopologyCopy());
-    through.topologyDifference(layer.grazed->tree());
-    through.topologyUnion(layer.crossed->tree());
-    return through;
-}
-
-namespace {
-
 // The verdicts on the tiles this rank owns (TileOwner) and who hit each removed voxel.
 void JudgeTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                 const dynamic::DynamicConfig& config, int64_t session, size_t budget,
@@ -157,6 +119,40 @@ void JudgeTiles(const store::MapStore& map, const store::Snapshot& snapshot,
 }
 
 }  // namespace
+
+double MemoryPerLayerByte(const store::MapStore& map, const store::Snapshot& snapshot) {
+    const auto largest = std::max_element(
+        snapshot.layers.begin(), snapshot.layers.end(),
+        [](const store::LayerFile& a, const store::LayerFile& b) { return a.bytes < b.bytes; });
+    if (largest == snapshot.layers.end() || largest->bytes == 0) return 1.0;
+    const store::SessionLayer layer = map.ReadLayer(*largest);
+    size_t memory = 0;
+    for (const auto* grid :
+         {&layer.occupied, &layer.free, &layer.crossed, &layer.grazed, &layer.hit}) {
+        if (*grid) memory += (*grid)->memUsage();
+    }
+    return std::max(1.0, static_cast<double>(memory) / static_cast<double>(largest->bytes));
+}
+
+void RequireCrossed(const store::SessionLayer& layer, const store::Snapshot& snapshot) {
+    if (!layer.crossed || !layer.grazed || !layer.hit) {
+        const auto s = std::find_if(snapshot.sessions.begin(), snapshot.sessions.end(),
+                                    [&](const auto& r) { return r.id == layer.session; });
+        const std::string name = s == snapshot.sessions.end() ? "" : " '" + s->name + "'";
+        throw RefusedError("session " + std::to_string(layer.session) + name +
+                           " was integrated before strata recorded the space its rays crossed "
+                           "(map format 6): integrate its scans again (`strata remove-session`, "
+                           "then `strata integrate`) to find what moved");
+    }
+}
+
+openvdb::MaskTree CrossedBy(const store::SessionLayer& layer, const store::Snapshot& snapshot) {
+    RequireCrossed(layer, snapshot);
+    openvdb::MaskTree through(layer.free->tree(), false, openvdb::TopologyCopy());
+    through.topologyDifference(layer.grazed->tree());
+    through.topologyUnion(layer.crossed->tree());
+    return through;
+}
 
 DynamicOutcome FindDynamicByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                                   const dynamic::DynamicConfig& config, int64_t session,
