@@ -58,6 +58,19 @@ std::vector<std::vector<openvdb::Coord>> Groups(std::vector<openvdb::Coord> voxe
     return groups;
 }
 
+// Calls `visit` with each active voxel of `tree` inside `region`, skipping the leaves outside it:
+// a map stored tile by tile applies the result once per tile. The result's grids hold voxels
+// only (GroupVerdicts sets them one by one), no active tiles.
+template <typename TreeT, typename Visit>
+void ForEachIn(const TreeT& tree, const openvdb::CoordBBox& region, Visit&& visit) {
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+        if (!region.hasOverlap(leaf->getNodeBoundingBox())) continue;
+        for (auto on = leaf->cbeginValueOn(); on; ++on) {
+            if (region.isInside(on.getCoord())) visit(on.getCoord());
+        }
+    }
+}
+
 }  // namespace
 
 void DynamicConfig::Validate() const {
@@ -189,19 +202,14 @@ void ApplyDynamic(const DynamicResult& result, const DynamicConfig& config, core
                   const openvdb::CoordBBox& region) {
     config.Validate();
     auto& occupancy = map.occupancy->tree();
-    for (auto on = result.restored->tree().cbeginValueOn(); on; ++on) {
-        if (region.isInside(on.getCoord())) {
-            occupancy.setValueOn(on.getCoord(), config.restored_log_odds);
-        }
-    }
+    ForEachIn(result.restored->tree(), region,
+              [&](const openvdb::Coord& c) { occupancy.setValueOn(c, config.restored_log_odds); });
     const auto dynamic = static_cast<int32_t>(core::SemanticClass::kDynamic);
-    for (auto on = result.removed->tree().cbeginValueOn(); on; ++on) {
-        const openvdb::Coord c = on.getCoord();
-        if (!region.isInside(c)) continue;
+    ForEachIn(result.removed->tree(), region, [&](const openvdb::Coord& c) {
         if (occupancy.getValue(c) > 0.0F) occupancy.setValueOn(c, config.removed_log_odds);
         map.endpoints->tree().setValueOff(c, 0);
         map.label->tree().setValueOn(c, dynamic);
-    }
+    });
 }
 
 }  // namespace strata::dynamic

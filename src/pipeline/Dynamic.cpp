@@ -75,13 +75,8 @@ int64_t SessionOf(const store::MapStore& map, const store::Snapshot& snapshot,
 }  // namespace
 
 bool DynamicReadsWhole(const store::MapStore& map, const store::Snapshot& snapshot, size_t budget) {
-    if (budget == 0) return true;
-    double layers = 0.0;
-    for (const store::LayerFile& l : snapshot.layers) layers += static_cast<double>(l.bytes);
-    const double fused = static_cast<double>(map.Bytes(snapshot).fused_current);
-    return fused * detail::MemoryPerFileByte(map, snapshot) +
-               layers * detail::MemoryPerLayerByte(map, snapshot) <=
-           static_cast<double>(budget);
+    return budget == 0 ||
+           detail::DynamicFitsWhole(map, snapshot, budget, detail::MeasureDecoded(map, snapshot));
 }
 
 DynamicOutcome FindDynamic(const store::MapStore& map, const store::Snapshot& snapshot,
@@ -89,9 +84,12 @@ DynamicOutcome FindDynamic(const store::MapStore& map, const store::Snapshot& sn
                            size_t memory_budget_bytes) {
     config.Validate();
     const int64_t only = SessionOf(map, snapshot, session);
-    if (!DynamicReadsWhole(map, snapshot, memory_budget_bytes)) {
-        return detail::FindDynamicByTiles(map, snapshot, config, only, memory_budget_bytes,
-                                          Ranks{});
+    if (memory_budget_bytes > 0) {
+        const detail::DecodedBytes decoded = detail::MeasureDecoded(map, snapshot);
+        if (!detail::DynamicFitsWhole(map, snapshot, memory_budget_bytes, decoded)) {
+            return detail::FindDynamicByTiles(map, snapshot, config, only, memory_budget_bytes,
+                                              decoded, Ranks{});
+        }
     }
     DynamicOutcome out;
     out.commit = snapshot.commit;
@@ -125,11 +123,13 @@ DynamicOutcome FindDynamicOnRanks(const store::MapStore& map, const store::Snaps
     if (ranks.size() == 1) return FindDynamic(map, snapshot, config, session, memory_budget_bytes);
     const store::Snapshot same = detail::SameSnapshotOnRanks(map, snapshot, ranks);
     int64_t only = 0;
+    detail::DecodedBytes decoded;
     OnEveryRank(ranks, [&] {
         config.Validate();
         only = SessionOf(map, same, session);
+        decoded = detail::MeasureDecoded(map, same);
     });
-    return detail::FindDynamicByTiles(map, same, config, only, memory_budget_bytes, ranks);
+    return detail::FindDynamicByTiles(map, same, config, only, memory_budget_bytes, decoded, ranks);
 }
 
 std::string DynamicRow(const dynamic::MovingObject& object, const std::vector<int64_t>& sessions) {

@@ -52,7 +52,8 @@ void GatherOnRoot(const Ranks& ranks, dynamic::VoxelVerdicts& verdicts, HitBy& h
 // The verdicts on the tiles this rank owns (TileOwner) and who hit each removed voxel.
 void JudgeTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                 const dynamic::DynamicConfig& config, int64_t session, size_t budget,
-                const Ranks& ranks, dynamic::VoxelVerdicts& verdicts, HitBy& hit_by) {
+                const DecodedBytes& decoded, const Ranks& ranks, dynamic::VoxelVerdicts& verdicts,
+                HitBy& hit_by) {
     std::map<store::TileKey, std::vector<int64_t>> sessions_in;  // the layers of each tile
     std::map<store::TileKey, uint64_t> layer_bytes;
     for (const store::LayerFile& l : snapshot.layers) {
@@ -67,14 +68,13 @@ void JudgeTiles(const store::MapStore& map, const store::Snapshot& snapshot,
         return keys;
     };
     // What a tile's turn holds in memory: its fused grids and its window's layers, decoded.
-    const double per_fused = MemoryPerFileByte(map, snapshot);
-    const double per_layer = MemoryPerLayerByte(map, snapshot);
     double largest = 0.0;
     for (const store::TileVersion& t : snapshot.tiles) {
-        double bytes = static_cast<double>(t.bytes) * per_fused;
+        double bytes = static_cast<double>(t.bytes) * decoded.per_fused_byte;
         for (const store::TileKey& k : window(t.key)) {
             const auto it = layer_bytes.find(k);
-            if (it != layer_bytes.end()) bytes += static_cast<double>(it->second) * per_layer;
+            if (it != layer_bytes.end())
+                bytes += static_cast<double>(it->second) * decoded.per_layer_byte;
         }
         largest = std::max(largest, bytes);
     }
@@ -120,18 +120,31 @@ void JudgeTiles(const store::MapStore& map, const store::Snapshot& snapshot,
 
 }  // namespace
 
-double MemoryPerLayerByte(const store::MapStore& map, const store::Snapshot& snapshot) {
+DecodedBytes MeasureDecoded(const store::MapStore& map, const store::Snapshot& snapshot) {
+    DecodedBytes decoded;
+    decoded.per_fused_byte = MemoryPerFileByte(map, snapshot);
     const auto largest = std::max_element(
         snapshot.layers.begin(), snapshot.layers.end(),
         [](const store::LayerFile& a, const store::LayerFile& b) { return a.bytes < b.bytes; });
-    if (largest == snapshot.layers.end() || largest->bytes == 0) return 1.0;
+    if (largest == snapshot.layers.end() || largest->bytes == 0) return decoded;
     const store::SessionLayer layer = map.ReadLayer(*largest);
     size_t memory = 0;
     for (const auto* grid :
          {&layer.occupied, &layer.free, &layer.crossed, &layer.grazed, &layer.hit}) {
         if (*grid) memory += (*grid)->memUsage();
     }
-    return std::max(1.0, static_cast<double>(memory) / static_cast<double>(largest->bytes));
+    decoded.per_layer_byte =
+        std::max(1.0, static_cast<double>(memory) / static_cast<double>(largest->bytes));
+    return decoded;
+}
+
+bool DynamicFitsWhole(const store::MapStore& map, const store::Snapshot& snapshot, size_t budget,
+                      const DecodedBytes& decoded) {
+    double layers = 0.0;
+    for (const store::LayerFile& l : snapshot.layers) layers += static_cast<double>(l.bytes);
+    const double fused = static_cast<double>(map.Bytes(snapshot).fused_current);
+    return fused * decoded.per_fused_byte + layers * decoded.per_layer_byte <=
+           static_cast<double>(budget);
 }
 
 void RequireCrossed(const store::SessionLayer& layer, const store::Snapshot& snapshot) {
@@ -156,11 +169,11 @@ openvdb::MaskTree CrossedBy(const store::SessionLayer& layer, const store::Snaps
 
 DynamicOutcome FindDynamicByTiles(const store::MapStore& map, const store::Snapshot& snapshot,
                                   const dynamic::DynamicConfig& config, int64_t session,
-                                  size_t budget, const Ranks& ranks) {
+                                  size_t budget, const DecodedBytes& decoded, const Ranks& ranks) {
     dynamic::VoxelVerdicts verdicts;
     HitBy hit_by;
     OnEveryRank(ranks, [&] {
-        JudgeTiles(map, snapshot, config, session, budget, ranks, verdicts, hit_by);
+        JudgeTiles(map, snapshot, config, session, budget, decoded, ranks, verdicts, hit_by);
     });
     if (ranks.size() > 1) GatherOnRoot(ranks, verdicts, hit_by);
     DynamicOutcome out;

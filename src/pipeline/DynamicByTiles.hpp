@@ -20,10 +20,18 @@ void RequireCrossed(const store::SessionLayer& layer, const store::Snapshot& sna
 [[nodiscard]] openvdb::MaskTree CrossedBy(const store::SessionLayer& layer,
                                           const store::Snapshot& snapshot);
 
-/// @brief Memory per byte of session layer file once decoded (at least 1), measured on the
-/// snapshot's largest layer file.
-[[nodiscard]] double MemoryPerLayerByte(const store::MapStore& map,
-                                        const store::Snapshot& snapshot);
+/// @brief Memory per byte of file once decoded (at least 1), fused and session layer files, each
+/// measured on the snapshot's largest file of its kind: measured once per command.
+struct DecodedBytes {
+    double per_fused_byte = 1.0;
+    double per_layer_byte = 1.0;
+};
+[[nodiscard]] DecodedBytes MeasureDecoded(const store::MapStore& map,
+                                          const store::Snapshot& snapshot);
+
+/// @brief Whether the snapshot's fused map and every session layer, decoded, fit `budget` bytes.
+[[nodiscard]] bool DynamicFitsWhole(const store::MapStore& map, const store::Snapshot& snapshot,
+                                    size_t budget, const DecodedBytes& decoded);
 
 /// @brief FindDynamic a tile at a time: each tile's candidates judged with the space crossed in
 /// it and its eight neighbours (a margin is at most 4 voxels, a tile at least 8), read through a
@@ -38,6 +46,7 @@ void RequireCrossed(const store::SessionLayer& layer, const store::Snapshot& sna
 [[nodiscard]] DynamicOutcome FindDynamicByTiles(const store::MapStore& map,
                                                 const store::Snapshot& snapshot,
                                                 const dynamic::DynamicConfig& config,
-                                                int64_t session, size_t budget, const Ranks& ranks);
+                                                int64_t session, size_t budget,
+                                                const DecodedBytes& decoded, const Ranks& ranks);
 
 }  // namespace strata::pipeline::detail
