@@ -14,6 +14,45 @@ namespace strata::pipeline {
 
 namespace {
 
+// What comes before anything is written, in the one process or on rank 0: the odometry's poses
+// (and `poses_out`) and the session's alignment; a refusal commits nothing. With both, the first
+// scan is aligned to the map and the odometry runs in the map's frame from there, the map's
+// points in its local map (OdometryInMap): the poses are the map's, the alignment the identity.
+// Without odometry the session's scans are aligned as posed.
+void PoseAndAlign(const store::MapStore& map, ScanSource& source, const IntegrateOptions& options,
+                  IntegrateResult& result, store::SessionOptions& session) {
+    const auto aligned = [&](const SourceCloud& cloud, const std::string& what) {
+        const MapAlignment a =
+            AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
+        if (options.on_aligned) options.on_aligned(a);
+        RequireAccepted(a, "--align: the alignment of " + what);
+        result.alignment = a;
+        return a;
+    };
+    if (options.odometry) {
+        OdometryOptions odometry = *options.odometry;
+        if (options.align) {
+            const core::Scan first = source.Read(0);  // the first scan, in its sensor's frame
+            const MapAlignment a =
+                aligned({first.points, 1, true}, "the first scan of " + source.Describe());
+            odometry.in_map = OdometryInMap{&map, map.Latest(), a.result.T_map_source};
+            session.notes =
+                "odometry started in the map; first scan's alignment " + AlignmentJson(a).dump();
+        }
+        result.odometry = EstimateTrajectory(source, odometry);
+        source =
+            source.Posed(result.odometry->scans, result.odometry->poses, result.odometry->times_s);
+        if (!options.poses_out.empty()) WriteTrajectory(options.poses_out, *result.odometry);
+        return;
+    }
+    if (!options.align) return;
+    const MapAlignment a =
+        aligned(ReadSourceCloud(source, false, options.align->options, options.progress),
+                source.Describe());
+    session.alignment = a.result.T_map_source.matrix();
+    session.notes = "alignment " + AlignmentJson(a).dump();
+}
+
 // Reads, aligns and integrates into an open map; commits only when every scan went in.
 IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOptions& options) {
     store::MapStore& map = opened.map;
@@ -23,26 +62,8 @@ IntegrateResult Run(OpenedMap& opened, const ScanSpec& scans, const IntegrateOpt
     store::SessionOptions session;
     session.name = options.name;
     session.source = source.Describe();
-    if (options.odometry) {
-        // Poses first, written before anything reaches the map: a refusal commits nothing.
-        result.odometry = EstimateTrajectory(source, *options.odometry);
-        source =
-            source.Posed(result.odometry->scans, result.odometry->poses, result.odometry->times_s);
-        if (!options.poses_out.empty()) WriteTrajectory(options.poses_out, *result.odometry);
-    }
     session.memory_budget_bytes = static_cast<size_t>(options.memory_budget_mb * 1e6);
-    if (options.align) {
-        // Aligned before anything is written: a refusal commits nothing.
-        const SourceCloud cloud =
-            ReadSourceCloud(source, false, options.align->options, options.progress);
-        const MapAlignment a =
-            AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
-        if (options.on_aligned) options.on_aligned(a);
-        RequireAccepted(a, "--align: the alignment of " + source.Describe());
-        session.alignment = a.result.T_map_source.matrix();
-        session.notes = "alignment " + AlignmentJson(a).dump();
-        result.alignment = a;
-    }
+    PoseAndAlign(map, source, options, result, session);
     if (options.on_start) options.on_start({map, source, opened.created, opened.rule});
 
     const auto start = core::Clock::now();
@@ -136,36 +157,20 @@ IntegrateResult RunOnRanks(const std::filesystem::path& dir, const MapRequest& r
         OnEveryRank(ranks, [&] { source.emplace(ScanSource::Open(scans, map.settings().origin)); });
         IntegrateResult result;
         result.created = created;
-        if (options.odometry) {
-            // Rank 0 estimates the poses (one scan after another, the odometry's nature) and
-            // writes them before anything reaches the map; every rank integrates at them.
-            OnEveryRank(ranks, [&] {
-                if (!ranks.root()) return;
-                result.odometry = EstimateTrajectory(*source, *options.odometry);
-                if (!options.poses_out.empty())
-                    WriteTrajectory(options.poses_out, *result.odometry);
-            });
-            const EstimatedTrajectory t = TrajectoryFromText(
-                ranks.Broadcast(ranks.root() ? TrajectoryText(*result.odometry) : std::string()));
-            source.emplace(source->Posed(t.scans, t.poses, t.times_s));
-        }
         store::SessionOptions session;
         session.name = options.name;
         session.source = source->Describe();
         session.memory_budget_bytes = static_cast<size_t>(options.memory_budget_mb * 1e6);
-        // Rank 0 aligns; every rank integrates with its transform.
+        // Rank 0 estimates the poses (one scan after another, the odometry's nature) and aligns;
+        // every rank integrates at those poses with that transform.
         OnEveryRank(ranks, [&] {
-            if (!ranks.root() || !options.align) return;
-            const SourceCloud cloud =
-                ReadSourceCloud(*source, false, options.align->options, options.progress);
-            const MapAlignment a =
-                AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
-            if (options.on_aligned) options.on_aligned(a);
-            RequireAccepted(a, "--align: the alignment of " + source->Describe());
-            session.alignment = a.result.T_map_source.matrix();
-            session.notes = "alignment " + AlignmentJson(a).dump();
-            result.alignment = a;
+            if (ranks.root()) PoseAndAlign(map, *source, options, result, session);
         });
+        if (options.odometry) {
+            const EstimatedTrajectory t = TrajectoryFromText(
+                ranks.Broadcast(ranks.root() ? TrajectoryText(*result.odometry) : std::string()));
+            if (!ranks.root()) source.emplace(source->Posed(t.scans, t.poses, t.times_s));
+        }
         const std::string alignment = ranks.Broadcast(AlignmentText(session.alignment));
         session.alignment = AlignmentFromText(alignment);
         if (ranks.root() && options.on_start) {

@@ -2,16 +2,112 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <map>
+#include <set>
+#include <utility>
 
 #include "strata/core/Error.hpp"
 #include "strata/io/PoseFiles.hpp"
+#include "strata/registration/Surface.hpp"
+#include "strata/store/TileReader.hpp"
 
 namespace strata::pipeline {
 
+namespace {
+
+// The stored map's occupied points (its voxels' point means) for a session's odometry, in square
+// blocks of kBlockM by kBlockM (x, y). A block joins the odometry's local map once the whole of
+// it lies within reach of the sensor, and again after the drive has been so far from it that the
+// local map forgot all of it (registration::OdometryConfig::max_range_m). A tile is read once,
+// when the first block that reaches into it is wanted; its points are kept by block.
+class StoredMapFeed {
+public:
+    StoredMapFeed(const OdometryInMap& in_map, double reach_m, double cell_m)
+        : reader_(*in_map.map, in_map.snapshot, 0), reach_m_(reach_m), cell_m_(cell_m) {}
+
+    // Adds the blocks that came within reach of `sensor` (map frame) to the local map, and
+    // forgets those the local map has dropped since they joined it.
+    void Around(const Eigen::Vector3d& sensor, registration::Odometry& odometry) {
+        const Eigen::Vector2d at = sensor.head<2>();
+        for (auto it = in_local_map_.begin(); it != in_local_map_.end();) {
+            const bool dropped = Distance(*it, at) - kHalfDiagonalM - cell_m_ > reach_m_;
+            it = dropped ? in_local_map_.erase(it) : std::next(it);
+        }
+        const Block lo = BlockOf(at - Eigen::Vector2d::Constant(reach_m_));
+        const Block hi = BlockOf(at + Eigen::Vector2d::Constant(reach_m_));
+        std::vector<Eigen::Vector3d> points;
+        for (int64_t bx = lo.first; bx <= hi.first; ++bx) {
+            for (int64_t by = lo.second; by <= hi.second; ++by) {
+                const Block b{bx, by};
+                if (Distance(b, at) + kHalfDiagonalM > reach_m_ || in_local_map_.count(b)) continue;
+                ReadTilesUnder(b);
+                in_local_map_.insert(b);
+                const auto found = blocks_.find(b);
+                if (found == blocks_.end()) continue;
+                points.insert(points.end(), found->second.begin(), found->second.end());
+            }
+        }
+        if (points.empty()) return;
+        odometry.AddToMap(points);
+        used_ += points.size();
+    }
+
+    [[nodiscard]] size_t used() const { return used_; }
+
+private:
+    static constexpr double kBlockM = 10.0;
+    static constexpr double kHalfDiagonalM = kBlockM * 0.70710678118654752;
+    using Block = std::pair<int64_t, int64_t>;
+
+    static Block BlockOf(const Eigen::Vector2d& p) {
+        return {static_cast<int64_t>(std::floor(p.x() / kBlockM)),
+                static_cast<int64_t>(std::floor(p.y() / kBlockM))};
+    }
+    static double Distance(const Block& b, const Eigen::Vector2d& p) {
+        const Eigen::Vector2d centre((static_cast<double>(b.first) + 0.5) * kBlockM,
+                                     (static_cast<double>(b.second) + 0.5) * kBlockM);
+        return (centre - p).norm();
+    }
+    // The points of every tile the block reaches into, sorted into blocks, each tile once.
+    void ReadTilesUnder(const Block& b) {
+        const Eigen::Vector2d lo(static_cast<double>(b.first) * kBlockM,
+                                 static_cast<double>(b.second) * kBlockM);
+        for (const store::TileKey& key :
+             reader_.Tiles(lo, lo + Eigen::Vector2d::Constant(kBlockM), 0)) {
+            if (!read_.insert(key).second) continue;
+            const auto fused = reader_.Fused(key);
+            if (!fused) continue;
+            for (const Eigen::Vector3d& p : registration::OccupiedPoints(*fused)) {
+                blocks_[BlockOf(p.head<2>())].push_back(p);
+            }
+        }
+    }
+
+    store::TileReader reader_;
+    double reach_m_;
+    double cell_m_;
+    std::set<store::TileKey> read_;
+    std::map<Block, std::vector<Eigen::Vector3d>> blocks_;
+    std::set<Block> in_local_map_;
+    size_t used_ = 0;
+};
+
+}  // namespace
+
 EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    registration::Odometry odometry(options.config);
+    std::optional<Eigen::Isometry3d> T_world_first;
+    std::optional<StoredMapFeed> feed;
+    if (options.in_map) {
+        if (options.in_map->map == nullptr) {
+            throw InvalidArgumentError("OdometryInMap: no map to start in");
+        }
+        T_world_first = options.in_map->T_map_first;
+        feed.emplace(*options.in_map, options.config.max_range_m, options.config.voxel_m);
+    }
+    registration::Odometry odometry(options.config, T_world_first);
     EstimatedTrajectory out;
     const recordings::RecordedScans* recording = source.recording();
     if (recording != nullptr && !recording->imu().angular_velocity.empty()) {
@@ -25,6 +121,11 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
     ReportProgress(options.progress, "odometry", 0, source.size());
     for (size_t i = 0; i < source.size(); ++i) {
         const core::Scan scan = source.Read(i);
+        if (feed) {
+            const Eigen::Isometry3d& last =
+                odometry.poses().empty() ? *T_world_first : odometry.poses().back();
+            feed->Around(last.translation(), odometry);
+        }
         const registration::OdometryStep step = odometry.Register(scan);
         if (!step.registered) {
             const std::string why =
@@ -53,7 +154,10 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
         ReportProgress(options.progress, "odometry", i + 1, source.size());
     }
     if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
-    if (recording != nullptr) {
+    if (feed) {
+        out.map_points_used = feed->used();
+    } else if (recording != nullptr) {
+        // In a stored map the map's up holds; else the IMU's gravity turns the poses level.
         const recordings::ImuReadings& imu = recording->imu();
         out.imu_note = imu.note;
         if (!imu.topic.empty()) {
@@ -97,6 +201,13 @@ std::string DescribePrediction(const EstimatedTrajectory& t) {
 
 std::string DescribeGravity(const EstimatedTrajectory& t) {
     char text[400];
+    if (t.map_points_used) {
+        std::snprintf(text, sizeof(text),
+                      "gravity: the map's z (the session started in the map; the odometry took "
+                      "in %zu of its points along the drive)",
+                      *t.map_points_used);
+        return text;
+    }
     if (t.imu && t.imu->found) {
         const registration::ImuLevel& i = *t.imu;
         std::snprintf(text, sizeof(text),

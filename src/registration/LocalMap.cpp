@@ -52,11 +52,16 @@ void LocalMap::FitShape(const Key& key, Cell& cell) const {
     }
 }
 
-void LocalMap::Add(const std::vector<Eigen::Vector3d>& points) {
+void LocalMap::Add(const std::vector<Eigen::Vector3d>& points, bool fixed) {
     std::vector<Key> changed;
     for (const Eigen::Vector3d& p : points) {
         const auto [it, fresh] = cells_.try_emplace(KeyOf(p));
         Cell& cell = it->second;
+        if (cell.fixed != fixed) {
+            if (!fixed) continue;  // the stored map's cell
+            cell.points.clear();   // the stored map's points replace a scan's
+            cell.fixed = true;
+        }
         if (cell.points.size() >= capacity_) continue;
         cell.points.push_back(p);
         if (!cell.changed) changed.push_back(it->first);

@@ -28,8 +28,10 @@ public:
     LocalMap(double cell_m, int max_points_per_cell, double max_planarity_ratio);
 
     /// @brief Adds points (world frame) to their cells, each up to its capacity, then refits the
-    /// shapes of the cells that changed.
-    void Add(const std::vector<Eigen::Vector3d>& points);
+    /// shapes of the cells that changed. `fixed` points are a stored map's: their cells hold only
+    /// such points (a scan's points there are dropped, and added later ones are refused), so a
+    /// scan registers to the stored surface where there is one, not to its own earlier copies.
+    void Add(const std::vector<Eigen::Vector3d>& points, bool fixed = false);
     /// @brief Drops the cells whose first point lies farther than `radius` from `centre`.
     void RemoveFarFrom(const Eigen::Vector3d& centre, double radius);
     /// @brief The nearest map point to `p` within `max_distance` (searching p's cell and the 26
@@ -58,6 +60,7 @@ private:
         std::vector<Eigen::Vector3d> points;
         Eigen::Vector3d axis = Eigen::Vector3d::Zero();
         Shape shape = Shape::kPoint;
+        bool fixed = false;    // a stored map's cell (Add)
         bool changed = false;  // within one Add
     };
     [[nodiscard]] Key KeyOf(const Eigen::Vector3d& p) const;

@@ -347,7 +347,8 @@ size_t Odometry::map_points() const { return state_->map.points(); }
 void Odometry::PredictRotationBy(Gyro gyro) { state_->gyro = std::move(gyro); }
 
 void Odometry::AddToMap(const std::vector<Eigen::Vector3d>& points_world) {
-    state_->map.Add(Downsample(points_world, kMapThinning * state_->config.voxel_m));
+    state_->map.Add(Downsample(points_world, kMapThinning * state_->config.voxel_m),
+                    /*fixed=*/true);
 }
 
 OdometryStep Odometry::Register(const std::vector<Eigen::Vector3d>& points) {

@@ -98,8 +98,10 @@ void PrintStart(const pipeline::IntegrationStart& s, const IntegrateArgs& args) 
                   << r->deskew_note() << "\n";
     }
     if (args.odometry) {
-        std::cerr << "strata integrate: poses by LiDAR odometry, in the first scan's frame turned "
-                     "level\n";
+        std::cerr << (args.align ? "strata integrate: poses by LiDAR odometry in the map, from the "
+                                   "first scan's alignment to it\n"
+                                 : "strata integrate: poses by LiDAR odometry, in the first scan's "
+                                   "frame turned level\n");
     }
 }
 
@@ -177,6 +179,7 @@ void RegisterIntegrate(CLI::App& app) {
         "  strata integrate street.strata --bag drive.bag --points-topic /points_raw\n"
         "  strata integrate street.strata --kitti drive/ --odometry --poses-out poses.txt\n"
         "  strata integrate street.strata --bag drive.mcap --odometry --poses-out poses.tum\n"
+        "  strata integrate street.strata --kitti day2/ --odometry --align --init 40,2,0,180\n"
         "Each run adds one session; the map changes only once every scan is integrated.");
     cmd->add_option("MAP", args->map, "Map directory (created when absent)")->required();
     AddScanOptions(*cmd, args->scans);
@@ -211,7 +214,8 @@ void RegisterIntegrate(CLI::App& app) {
                   "docs/dynamic.md)");
     cmd->add_flag("--align", args->align,
                   "Align the session to the map first (strata register); refuse and commit "
-                  "nothing when it fails; the transform is kept as the session's alignment");
+                  "nothing when it fails; the transform is kept as the session's alignment. With "
+                  "--odometry: the first scan is aligned and the odometry runs in the map");
     AddAlignOptions(*cmd, args->align_args, false);
     cmd->add_flag("--odometry", args->odometry,
                   "Estimate the scans' poses by LiDAR odometry first (any poses they have are "

@@ -31,11 +31,13 @@ struct IntegrateOptions {
     std::string name;               ///< the session's name; default session_<id>
     double memory_budget_mb = 0.0;  ///< tiles kept in memory; 0: no limit
     /// Align the session (its scans in their poses' frame) to the newest map first; the
-    /// transform is recorded as the session's alignment.
+    /// transform is recorded as the session's alignment. With `odometry`: align the first scan,
+    /// then run the odometry in the map's frame with the map's points (OdometryInMap; the
+    /// session's alignment stays the identity).
     std::optional<AlignRequest> align;
     /// Estimate the scans' poses by odometry first (their own poses, if any, are ignored; a KITTI
-    /// folder needs no poses.txt), then integrate (and align, with `align`) at those; one process
-    /// only (docs/odometry.md).
+    /// folder needs no poses.txt), then integrate at those; on ranks, rank 0 estimates them
+    /// (docs/odometry.md).
     std::optional<OdometryOptions> odometry;
     /// With `odometry`: the trajectory also written here (.txt KITTI, .tum TUM), before the
     /// session commits.

@@ -12,12 +12,27 @@
 #include "strata/pipeline/ScanSource.hpp"
 #include "strata/registration/ImuGravity.hpp"
 #include "strata/registration/Odometry.hpp"
+#include "strata/store/MapStore.hpp"
 
 namespace strata::pipeline {
+
+/// @brief A session whose odometry starts in a stored map (`integrate --odometry --align`): the
+/// first scan lies at `T_map_first` (an alignment of it to the map), and the map's occupied
+/// points join the odometry's local map as the drive comes within reach of them, so every scan
+/// registers to the map as well as to the scans before it; the poses are the map's
+/// (docs/odometry.md, "A session that starts in a map").
+struct OdometryInMap {
+    const store::MapStore* map = nullptr;  ///< must outlive the estimation
+    store::Snapshot snapshot;
+    Eigen::Isometry3d T_map_first = Eigen::Isometry3d::Identity();
+};
 
 /// @brief How the poses of a source's scans are estimated.
 struct OdometryOptions {
     registration::OdometryConfig config;
+    /// Start in a stored map instead of a world of the session's own (levelled by its first scan
+    /// or the IMU): the map's frame and its up hold.
+    std::optional<OdometryInMap> in_map;
     /// A scan the odometry cannot register stops the run (false) or is left out and listed in
     /// EstimatedTrajectory::skipped (true).
     bool skip_failures = false;
@@ -46,6 +61,9 @@ struct EstimatedTrajectory {
     /// model's), and why the gyro was not used when it was read but not used.
     size_t gyro_predicted = 0;
     std::string gyro_failure;
+    /// With OdometryOptions::in_map: the map's points the local map took in over the drive (a
+    /// block of the map again each time the drive came back within reach of it).
+    std::optional<size_t> map_points_used;
 };
 
 /// @brief What the program warns of after a run, a line each: the scans left out, and how many
@@ -57,13 +75,14 @@ struct EstimatedTrajectory {
 [[nodiscard]] std::string DescribePrediction(const EstimatedTrajectory& trajectory);
 
 /// @brief One line on where the map's up came from, for the program's output: "gravity: the
-/// IMU's accelerometer ...", "gravity: the first scan's ground plane, ..." or "gravity: none
-/// found (...): z is the first scan's".
+/// IMU's accelerometer ...", "gravity: the first scan's ground plane, ...", "gravity: none
+/// found (...): z is the first scan's" or, started in a stored map, "gravity: the map's z ...".
 [[nodiscard]] std::string DescribeGravity(const EstimatedTrajectory& trajectory);
 
 /// @brief Reads each scan of `source` and registers it; with a recording's IMU, predicts each
-/// scan's rotation by its gyro (registration::Odometry::PredictRotationBy) and turns the poses
-/// level by its accelerometer (registration::LevelFromAccelerometer).
+/// scan's rotation by its gyro (registration::Odometry::PredictRotationBy) and, unless the
+/// session starts in a stored map (OdometryOptions::in_map), turns the poses level by its
+/// accelerometer (registration::LevelFromAccelerometer).
 /// @throw RefusedError naming the scan and why ("scan 12 (<file>): too little overlap ...")
 /// when one cannot be registered and `skip_failures` is false, or when no scan was registered;
 /// the readers' errors; InvalidArgumentError for a bad config.

@@ -115,7 +115,10 @@ public:
     /// sweep at 10 Hz). A sweep with its points' times is first deskewed by that prediction.
     void PredictRotationBy(Gyro gyro);
     /// @brief Adds points (world frame) to the local map without a pose: an existing map's
-    /// surface around where a session starts.
+    /// surface around a session in it. Their cells take no points of the scans (a scan's points
+    /// already there are dropped): the scans register to the map's surface where it has one and
+    /// extend the local map where it has none. They leave the local map out of range as the
+    /// scans' points do.
     void AddToMap(const std::vector<Eigen::Vector3d>& points_world);
 
     /// @brief The poses of the registered scans, in order.
