@@ -4,6 +4,7 @@
 
 #include "strata/core/Error.hpp"
 #include "strata/core/Labels.hpp"
+#include "strata/registration/Register.hpp"
 
 namespace strata::python {
 
@@ -80,6 +81,22 @@ Eigen::Isometry3d PoseFromArray(const py::array& pose, const char* name) {
     Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
     out.matrix() = T;
     return out;
+}
+
+Eigen::Isometry3d GuessFromArray(const py::object& guess, const char* name) {
+    const py::array a = py::array::ensure(guess);
+    if (a && a.ndim() == 1 && a.shape(0) == 4) {
+        const auto values = py::array_t<double, py::array::forcecast>(a);
+        const auto v = values.unchecked<1>();
+        if (!std::isfinite(v(0) + v(1) + v(2) + v(3))) {
+            throw InvalidArgumentError(std::string(name) + " must be finite");
+        }
+        return registration::PoseFromXyzYaw(v(0), v(1), v(2), v(3));
+    }
+    if (!a) {
+        throw InvalidArgumentError(std::string(name) + " must be a 4x4 pose or (x, y, z, yaw_deg)");
+    }
+    return PoseFromArray(a, name);
 }
 
 std::vector<uint32_t> IdsFromArray(const py::array& ids, size_t count, const char* name) {

@@ -24,6 +24,8 @@ namespace py = pybind11;
                                                            const char* name = "points");
 /// (4, 4) or (3, 4), finite, rotation orthonormal with determinant +1, last row 0 0 0 1.
 [[nodiscard]] Eigen::Isometry3d PoseFromArray(const py::array& pose, const char* name = "pose");
+/// A guess of a pose: a (4, 4) / (3, 4) pose as PoseFromArray, or (x, y, z, yaw_deg) finite.
+[[nodiscard]] Eigen::Isometry3d GuessFromArray(const py::object& guess, const char* name);
 /// (N,) non-negative integers of any integer dtype, N = `count`.
 [[nodiscard]] std::vector<uint32_t> IdsFromArray(const py::array& ids, size_t count,
                                                  const char* name);

@@ -3,12 +3,13 @@
 #include <memory>
 #include <optional>
 
+#include "Analyses.hpp"
 #include "Arrays.hpp"
 #include "StoredMap.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/pipeline/NewSession.hpp"
+#include "strata/pipeline/Odometry.hpp"
 #include "strata/recordings/Deskew.hpp"
-#include "strata/registration/Odometry.hpp"
 
 namespace strata::python {
 
@@ -18,7 +19,8 @@ namespace {
 /// an exception in a `with` block) leaves the map as it was.
 class Session {
 public:
-    Session(const StoredMap& map, const std::string& name, double memory_budget_mb, bool odometry)
+    Session(const StoredMap& map, const std::string& name, double memory_budget_mb, bool odometry,
+            const py::object& start)
         : store_(map.store) {
         if (!store_) throw InvalidArgumentError("the map is closed");
         if (!store_->writable()) {
@@ -31,8 +33,17 @@ public:
         options.name = name;
         options.source = "python";
         options.memory_budget_bytes = static_cast<size_t>(memory_budget_mb * 1e6);
+        std::optional<pipeline::OdometryStart> in_map;
+        if (!start.is_none()) {
+            if (!odometry) {
+                throw InvalidArgumentError("start is for a session made with odometry=True");
+            }
+            // The map as it is now: what this session writes is not read back.
+            in_map = pipeline::OdometryStart{store_.get(), store_->Latest(), {}, {}};
+            in_map->align.guess = GuessFromArray(start, "start");
+        }
         session_ = std::make_unique<pipeline::NewSession>(*store_, map.config, options);
-        if (odometry) odometry_.emplace();
+        if (odometry) odometry_.emplace(registration::OdometryConfig{}, std::move(in_map));
     }
 
     py::dict Integrate(const py::array& points, const py::object& pose, const py::object& labels,
@@ -70,9 +81,7 @@ public:
             if (odometry_) {
                 // With its points' times, a sweep is predicted and deskewed over its instant
                 // and integrated deskewed by the motion found (docs/odometry.md).
-                const registration::OdometryStep step = scan.times_s.empty()
-                                                            ? odometry_->Register(scan.points)
-                                                            : odometry_->Register(scan);
+                const registration::OdometryStep step = odometry_->Register(scan);
                 if (!step.registered) {
                     throw RefusedError("scan " + std::to_string(session.scans()) +
                                        " (numpy): " + step.failure);
@@ -105,6 +114,12 @@ public:
     // Where the map's up came from (docs/odometry.md, "Gravity"); None without odometry or
     // before the first scan.
     [[nodiscard]] py::object Gravity() const {
+        if (odometry_ && odometry_->alignment()) {
+            py::dict d;
+            d["source"] = "map";
+            d["map_points"] = odometry_->map_points_used().value_or(0);
+            return d;
+        }
         if (!ground_) return py::none();
         py::dict d;
         d["source"] = ground_->found ? "ground_plane" : "first_scan";
@@ -114,6 +129,16 @@ public:
         d["height_m"] = ground_->height_m;
         d["failure"] = ground_->failure;
         return d;
+    }
+
+    // The first scan's alignment to the map (as Map.register reports it), for a session that
+    // started in the map once that scan is in; else None.
+    [[nodiscard]] py::object Alignment() const {
+        if (!odometry_ || !odometry_->alignment()) return py::none();
+        const pipeline::MapAlignment& a = *odometry_->alignment();
+        py::dict report = ParseJson(pipeline::AlignmentJson(a).dump());
+        report["pose"] = MatrixToArray(a.result.T_map_source.matrix());
+        return report;
     }
 
     py::dict Commit() {
@@ -145,9 +170,9 @@ private:
 
     std::shared_ptr<store::MapStore> store_;  // the writer refers to it: kept alive with it
     std::unique_ptr<pipeline::NewSession> session_;
-    std::optional<registration::Odometry> odometry_;   // odometry=True: poses estimated
-    std::vector<double> stamps_;                       // of the poses the odometry found
-    std::optional<registration::GroundLevel> ground_;  // what levelled the odometry's world
+    std::optional<pipeline::SessionOdometry> odometry_;  // odometry=True: poses estimated
+    std::vector<double> stamps_;                         // of the poses the odometry found
+    std::optional<registration::GroundLevel> ground_;    // what levelled the odometry's world
     std::optional<py::dict> committed_;
 };
 
@@ -155,8 +180,9 @@ private:
 
 void RegisterSession(py::module_& m) {
     py::class_<Session>(m, "_Session")
-        .def(py::init<const StoredMap&, const std::string&, double, bool>(), py::arg("map"),
-             py::arg("name"), py::arg("memory_budget_mb") = 0.0, py::arg("odometry") = false)
+        .def(py::init<const StoredMap&, const std::string&, double, bool, const py::object&>(),
+             py::arg("map"), py::arg("name"), py::arg("memory_budget_mb") = 0.0,
+             py::arg("odometry") = false, py::arg("start") = py::none())
         .def("integrate", &Session::Integrate, py::arg("points"), py::arg("pose"),
              py::arg("labels") = py::none(), py::arg("classes") = py::none(),
              py::arg("ray_origins") = py::none(), py::arg("ray_starts") = py::none(),
@@ -165,7 +191,8 @@ void RegisterSession(py::module_& m) {
         .def("abort", &Session::Abort)
         .def_property_readonly("record", &Session::Record)
         .def_property_readonly("poses", &Session::Poses)
-        .def_property_readonly("gravity", &Session::Gravity);
+        .def_property_readonly("gravity", &Session::Gravity)
+        .def_property_readonly("alignment", &Session::Alignment);
 }
 
 }  // namespace strata::python

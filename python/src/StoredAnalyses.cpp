@@ -28,19 +28,7 @@ namespace {
 using store::MapStore;
 
 /// T_map_source from a (4, 4) / (3, 4) pose or (x, y, z, yaw_deg).
-Eigen::Isometry3d GuessFrom(const py::object& init) {
-    const py::array a = py::array::ensure(init);
-    if (a && a.ndim() == 1 && a.shape(0) == 4) {
-        const auto values = py::array_t<double, py::array::forcecast>(a);
-        const auto v = values.unchecked<1>();
-        if (!std::isfinite(v(0) + v(1) + v(2) + v(3))) {
-            throw InvalidArgumentError("init must be finite");
-        }
-        return registration::PoseFromXyzYaw(v(0), v(1), v(2), v(3));
-    }
-    if (!a) throw InvalidArgumentError("init must be a 4x4 pose or (x, y, z, yaw_deg)");
-    return PoseFromArray(a, "init");
-}
+Eigen::Isometry3d GuessFrom(const py::object& init) { return GuessFromArray(init, "init"); }
 
 /// Products are stored for the newest map of a map open for writing: checked before the work.
 void CheckSave(const MapStore& store, const std::string& as_of, const std::string& what) {

@@ -126,10 +126,10 @@ class Session:
     """
 
     def __init__(self, map: "Map", name: str = "", memory_budget_mb: float = 0.0,
-                 odometry: bool = False):
+                 odometry: bool = False, start=None):
         self._map = map
         self._odometry = odometry
-        self._impl = _strata._Session(map._impl, name, memory_budget_mb, odometry)
+        self._impl = _strata._Session(map._impl, name, memory_budget_mb, odometry, start)
 
     def integrate(self, points, pose=None, labels=None, classes=None, ray_origins=None,
                   ray_starts=None, times=None, time: float = 0.0) -> dict:
@@ -157,16 +157,24 @@ class Session:
     @property
     def poses(self) -> Optional[np.ndarray]:
         """With odometry=True, the poses the odometry found so far, (N, 4, 4) in the first scan's
-        frame turned level by its ground plane (docs/odometry.md); None for a session given its
-        poses."""
+        frame turned level by its ground plane, or in the map's frame for a session given a
+        `start` (docs/odometry.md); None for a session given its poses."""
         return self._impl.poses
+
+    @property
+    def alignment(self) -> Optional[dict]:
+        """For a session given a `start`, once its first scan is in: that scan's alignment to the
+        map, as Map.register reports it (T, converged, rmse_m, overlap, ..., "pose"); else
+        None."""
+        return self._impl.alignment
 
     @property
     def gravity(self) -> Optional[dict]:
         """With odometry=True, where the map's up came from once a scan is in: {"source":
         "ground_plane" (the first scan's ground) or "first_scan" (none found: the first scan's
-        z), "tilt_deg", "points", "rms_m", "height_m", "failure" (why no ground)}; else None
-        (docs/odometry.md, "Gravity")."""
+        z), "tilt_deg", "points", "rms_m", "height_m", "failure" (why no ground)}, or for a
+        session given a `start` {"source": "map", "map_points": the map's points its odometry
+        took in}; else None (docs/odometry.md, "Gravity")."""
         return self._impl.gravity
 
     def commit(self) -> dict:
@@ -245,11 +253,15 @@ class Map:
         return self._impl.voxel_size
 
     def session(self, name: str = "", memory_budget_mb: float = 0.0,
-                odometry: bool = False) -> Session:
+                odometry: bool = False, start=None) -> Session:
         """A new session named `name` (default session_<id>); use it in a `with` block.
         memory_budget_mb > 0 keeps at most that many MB of tiles in memory. odometry=True: the
-        scans come without poses and LiDAR odometry estimates them (docs/odometry.md)."""
-        return Session(self, name, memory_budget_mb, odometry)
+        scans come without poses and LiDAR odometry estimates them (docs/odometry.md); with
+        `start` (a guess of the first scan's pose in the map: a 4x4 pose or (x, y, z, yaw_deg))
+        the session starts in the map as `strata integrate --odometry --align --init` does: its
+        first scan is aligned to the map (RefusedError when it does not fit) and the odometry
+        runs in the map's frame, on the map's points."""
+        return Session(self, name, memory_budget_mb, odometry, start)
 
     def sessions(self) -> list:
         """The map's sessions, oldest first, as dicts (id, name, scans, points, ...)."""

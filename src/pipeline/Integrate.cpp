@@ -15,42 +15,38 @@ namespace strata::pipeline {
 namespace {
 
 // What comes before anything is written, in the one process or on rank 0: the odometry's poses
-// (and `poses_out`) and the session's alignment; a refusal commits nothing. With both, the first
-// scan is aligned to the map and the odometry runs in the map's frame from there, the map's
-// points in its local map (OdometryInMap): the poses are the map's, the alignment the identity.
-// Without odometry the session's scans are aligned as posed.
+// (and `poses_out`) and the session's alignment; a refusal commits nothing. With both, the
+// odometry starts in the map (OdometryStart: its first scan aligned, its poses the map's), and
+// the session's alignment stays the identity; without odometry the session's scans are aligned
+// as posed.
 void PoseAndAlign(const store::MapStore& map, ScanSource& source, const IntegrateOptions& options,
                   IntegrateResult& result, store::SessionOptions& session) {
-    const auto aligned = [&](const SourceCloud& cloud, const std::string& what) {
-        const MapAlignment a =
-            AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
-        if (options.on_aligned) options.on_aligned(a);
-        RequireAccepted(a, "--align: the alignment of " + what);
-        result.alignment = a;
-        return a;
-    };
     if (options.odometry) {
         OdometryOptions odometry = *options.odometry;
         if (options.align) {
-            const core::Scan first = source.Read(0);  // the first scan, in its sensor's frame
-            const MapAlignment a =
-                aligned({first.points, 1, true}, "the first scan of " + source.Describe());
-            odometry.in_map = OdometryInMap{&map, map.Latest(), a.result.T_map_source};
-            session.notes =
-                "odometry started in the map; first scan's alignment " + AlignmentJson(a).dump();
+            odometry.start = OdometryStart{&map, map.Latest(), *options.align, options.on_aligned};
         }
         result.odometry = EstimateTrajectory(source, odometry);
+        if (result.odometry->alignment) {
+            result.alignment = result.odometry->alignment;
+            session.notes = "odometry started in the map; first scan's alignment " +
+                            AlignmentJson(*result.alignment).dump();
+        }
         source =
             source.Posed(result.odometry->scans, result.odometry->poses, result.odometry->times_s);
         if (!options.poses_out.empty()) WriteTrajectory(options.poses_out, *result.odometry);
         return;
     }
     if (!options.align) return;
+    const SourceCloud cloud =
+        ReadSourceCloud(source, false, options.align->options, options.progress);
     const MapAlignment a =
-        aligned(ReadSourceCloud(source, false, options.align->options, options.progress),
-                source.Describe());
+        AlignToMap(map, map.Latest(), cloud, options.align->guess, options.align->options);
+    if (options.on_aligned) options.on_aligned(a);
+    RequireAccepted(a, "--align: the alignment of " + source.Describe());
     session.alignment = a.result.T_map_source.matrix();
     session.notes = "alignment " + AlignmentJson(a).dump();
+    result.alignment = a;
 }
 
 // Reads, aligns and integrates into an open map; commits only when every scan went in.

@@ -15,7 +15,7 @@
 
 namespace strata::pipeline {
 
-namespace {
+namespace detail {
 
 // The stored map's occupied points (its voxels' point means) for a session's odometry, in square
 // blocks of kBlockM by kBlockM (x, y). A block joins the odometry's local map once the whole of
@@ -24,8 +24,9 @@ namespace {
 // when the first block that reaches into it is wanted; its points are kept by block.
 class StoredMapFeed {
 public:
-    StoredMapFeed(const OdometryInMap& in_map, double reach_m, double cell_m)
-        : reader_(*in_map.map, in_map.snapshot, 0), reach_m_(reach_m), cell_m_(cell_m) {}
+    StoredMapFeed(const store::MapStore& map, const store::Snapshot& snapshot, double reach_m,
+                  double cell_m)
+        : reader_(map, snapshot, 0), reach_m_(reach_m), cell_m_(cell_m) {}
 
     // Adds the blocks that came within reach of `sensor` (map frame) to the local map, and
     // forgets those the local map has dropped since they joined it.
@@ -94,20 +95,82 @@ private:
     size_t used_ = 0;
 };
 
-}  // namespace
+}  // namespace detail
+
+struct SessionOdometry::State {
+    registration::OdometryConfig config;
+    std::optional<OdometryStart> start;
+    std::optional<registration::Gyro> gyro;
+    // Made at the first scan: started in a map, its world is where that scan's alignment puts it.
+    std::optional<registration::Odometry> odometry;
+    Eigen::Isometry3d T_world_first = Eigen::Isometry3d::Identity();
+    std::optional<MapAlignment> alignment;
+    std::optional<detail::StoredMapFeed> feed;
+
+    // The odometry for the first scan, `scan`: in a world of its own, or where the scan's
+    // alignment to the stored map puts it, with the map's points to come.
+    void Begin(const core::Scan& scan) {
+        std::optional<Eigen::Isometry3d> first;
+        if (start) {
+            if (start->map == nullptr) throw InvalidArgumentError("OdometryStart: no map");
+            const MapAlignment a = AlignToMap(*start->map, start->snapshot, {scan.points, 1, true},
+                                              start->align.guess, start->align.options);
+            if (start->on_aligned) start->on_aligned(a);
+            RequireAccepted(a,
+                            "the first scan's alignment to the map" +
+                                (scan.source.empty() ? std::string() : " (" + scan.source + ")"));
+            alignment = a;
+            T_world_first = a.result.T_map_source;
+            first = T_world_first;
+            feed.emplace(*start->map, start->snapshot, config.max_range_m, config.voxel_m);
+        }
+        odometry.emplace(config, first);
+        if (gyro) odometry->PredictRotationBy(*gyro);
+    }
+};
+
+SessionOdometry::SessionOdometry(const registration::OdometryConfig& config,
+                                 std::optional<OdometryStart> start)
+    : state_(std::make_unique<State>()) {
+    config.Validate();
+    state_->config = config;
+    state_->start = std::move(start);
+}
+SessionOdometry::~SessionOdometry() = default;
+SessionOdometry::SessionOdometry(SessionOdometry&&) noexcept = default;
+SessionOdometry& SessionOdometry::operator=(SessionOdometry&&) noexcept = default;
+
+registration::OdometryStep SessionOdometry::Register(const core::Scan& scan) {
+    State& s = *state_;
+    if (!s.odometry) s.Begin(scan);
+    if (s.feed) {
+        const std::vector<Eigen::Isometry3d>& poses = s.odometry->poses();
+        const Eigen::Isometry3d& last = poses.empty() ? s.T_world_first : poses.back();
+        s.feed->Around(last.translation(), *s.odometry);
+    }
+    return s.odometry->Register(scan);
+}
+
+void SessionOdometry::PredictRotationBy(registration::Gyro gyro) {
+    if (state_->odometry) state_->odometry->PredictRotationBy(gyro);
+    state_->gyro = std::move(gyro);
+}
+
+const std::vector<Eigen::Isometry3d>& SessionOdometry::poses() const {
+    static const std::vector<Eigen::Isometry3d> kNone;
+    return state_->odometry ? state_->odometry->poses() : kNone;
+}
+
+const std::optional<MapAlignment>& SessionOdometry::alignment() const { return state_->alignment; }
+
+std::optional<size_t> SessionOdometry::map_points_used() const {
+    if (!state_->start) return std::nullopt;
+    return state_->feed ? state_->feed->used() : 0;
+}
 
 EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    std::optional<Eigen::Isometry3d> T_world_first;
-    std::optional<StoredMapFeed> feed;
-    if (options.in_map) {
-        if (options.in_map->map == nullptr) {
-            throw InvalidArgumentError("OdometryInMap: no map to start in");
-        }
-        T_world_first = options.in_map->T_map_first;
-        feed.emplace(*options.in_map, options.config.max_range_m, options.config.voxel_m);
-    }
-    registration::Odometry odometry(options.config, T_world_first);
+    SessionOdometry odometry(options.config, options.start);
     EstimatedTrajectory out;
     const recordings::RecordedScans* recording = source.recording();
     if (recording != nullptr && !recording->imu().angular_velocity.empty()) {
@@ -121,11 +184,6 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
     ReportProgress(options.progress, "odometry", 0, source.size());
     for (size_t i = 0; i < source.size(); ++i) {
         const core::Scan scan = source.Read(i);
-        if (feed) {
-            const Eigen::Isometry3d& last =
-                odometry.poses().empty() ? *T_world_first : odometry.poses().back();
-            feed->Around(last.translation(), odometry);
-        }
         const registration::OdometryStep step = odometry.Register(scan);
         if (!step.registered) {
             const std::string why =
@@ -154,13 +212,13 @@ EstimatedTrajectory EstimateTrajectory(const ScanSource& source, const OdometryO
         ReportProgress(options.progress, "odometry", i + 1, source.size());
     }
     if (out.poses.empty()) throw RefusedError("the odometry registered none of the scans");
-    if (feed) {
-        out.map_points_used = feed->used();
-    } else if (recording != nullptr) {
-        // In a stored map the map's up holds; else the IMU's gravity turns the poses level.
+    out.alignment = odometry.alignment();
+    out.map_points_used = odometry.map_points_used();
+    if (recording != nullptr) {
         const recordings::ImuReadings& imu = recording->imu();
         out.imu_note = imu.note;
-        if (!imu.topic.empty()) {
+        // In a stored map the map's up holds; else the IMU's gravity turns the poses level.
+        if (!options.start && !imu.topic.empty()) {
             out.imu = registration::LevelFromAccelerometer({imu.times_s, imu.specific_force},
                                                            out.times_s, out.poses);
             if (out.imu->found) {

@@ -217,7 +217,7 @@ TEST(OdometryCli, ASessionWithoutPosesStartsInTheMapAndStaysOnIt) {
     EXPECT_TRUE(
         FailedWith(Strata("integrate " + map.string() + " --kitti " + second.string() +
                           " --odometry --align --init 60,40,0,90 --poses-out " + refused.string()),
-                   kRefused, "the first scan of"));
+                   kRefused, "the first scan's alignment to the map"));
     EXPECT_EQ(MapFiles(map), before);
     EXPECT_FALSE(fs::exists(refused));
 }

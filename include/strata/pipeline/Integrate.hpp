@@ -32,7 +32,7 @@ struct IntegrateOptions {
     double memory_budget_mb = 0.0;  ///< tiles kept in memory; 0: no limit
     /// Align the session (its scans in their poses' frame) to the newest map first; the
     /// transform is recorded as the session's alignment. With `odometry`: align the first scan,
-    /// then run the odometry in the map's frame with the map's points (OdometryInMap; the
+    /// then run the odometry in the map's frame with the map's points (OdometryStart; the
     /// session's alignment stays the identity).
     std::optional<AlignRequest> align;
     /// Estimate the scans' poses by odometry first (their own poses, if any, are ignored; a KITTI

@@ -4,27 +4,62 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "strata/pipeline/Alignment.hpp"
 #include "strata/pipeline/Progress.hpp"
 #include "strata/pipeline/ScanSource.hpp"
 #include "strata/registration/ImuGravity.hpp"
 #include "strata/registration/Odometry.hpp"
-#include "strata/store/MapStore.hpp"
 
 namespace strata::pipeline {
 
-/// @brief A session whose odometry starts in a stored map (`integrate --odometry --align`): the
-/// first scan lies at `T_map_first` (an alignment of it to the map), and the map's occupied
-/// points join the odometry's local map as the drive comes within reach of them, so every scan
-/// registers to the map as well as to the scans before it; the poses are the map's
-/// (docs/odometry.md, "A session that starts in a map").
-struct OdometryInMap {
-    const store::MapStore* map = nullptr;  ///< must outlive the estimation
+/// @brief Where a session's odometry starts when not in a world of its own: in a stored map, its
+/// first scan aligned to the map near `align.guess` as AlignToMap aligns one scan; the odometry
+/// then runs in the map's frame, and the map's occupied points join its local map as the drive
+/// comes within reach of them, so every scan registers to the map as well as to the scans before
+/// it (docs/odometry.md, "A session that starts in a map").
+struct OdometryStart {
+    const store::MapStore* map = nullptr;  ///< must outlive the odometry
     store::Snapshot snapshot;
-    Eigen::Isometry3d T_map_first = Eigen::Isometry3d::Identity();
+    AlignRequest align;
+    /// Called with the first scan's alignment before it is accepted or refused.
+    std::function<void(const MapAlignment&)> on_aligned;
+};
+
+/// @brief A session's odometry, scan by scan (`strata integrate --odometry`, `strata odometry`,
+/// Python's sessions): registration::Odometry in a world of its own, or started in a stored map
+/// (OdometryStart), whose points it reads tile by tile as the drive reaches them.
+class SessionOdometry {
+public:
+    explicit SessionOdometry(const registration::OdometryConfig& config,
+                             std::optional<OdometryStart> start = std::nullopt);
+    ~SessionOdometry();
+    SessionOdometry(SessionOdometry&&) noexcept;
+    SessionOdometry& operator=(SessionOdometry&&) noexcept;
+
+    /// @brief Registers the next scan (registration::Odometry::Register). Started in a map, the
+    /// first scan is aligned to it first.
+    /// @throw RefusedError ("the first scan's alignment to the map (<source>) refused: why")
+    /// when that alignment is refused; the errors of AlignToMap and of the map's tiles.
+    registration::OdometryStep Register(const core::Scan& scan);
+    /// @brief registration::Odometry::PredictRotationBy.
+    void PredictRotationBy(registration::Gyro gyro);
+    /// @brief The poses of the registered scans, in order (the map's frame when started in one).
+    [[nodiscard]] const std::vector<Eigen::Isometry3d>& poses() const;
+    /// @brief Started in a map: the first scan's alignment to it, once that scan came.
+    [[nodiscard]] const std::optional<MapAlignment>& alignment() const;
+    /// @brief Started in a map: the map's points the local map took in so far (a part of the
+    /// map again each time the drive came back within reach of it); else nullopt.
+    [[nodiscard]] std::optional<size_t> map_points_used() const;
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
 };
 
 /// @brief How the poses of a source's scans are estimated.
@@ -32,7 +67,7 @@ struct OdometryOptions {
     registration::OdometryConfig config;
     /// Start in a stored map instead of a world of the session's own (levelled by its first scan
     /// or the IMU): the map's frame and its up hold.
-    std::optional<OdometryInMap> in_map;
+    std::optional<OdometryStart> start;
     /// A scan the odometry cannot register stops the run (false) or is left out and listed in
     /// EstimatedTrajectory::skipped (true).
     bool skip_failures = false;
@@ -61,8 +96,9 @@ struct EstimatedTrajectory {
     /// model's), and why the gyro was not used when it was read but not used.
     size_t gyro_predicted = 0;
     std::string gyro_failure;
-    /// With OdometryOptions::in_map: the map's points the local map took in over the drive (a
-    /// block of the map again each time the drive came back within reach of it).
+    /// Started in a map (OdometryOptions::start): the first scan's alignment to it, and the
+    /// map's points the local map took in over the drive (SessionOdometry).
+    std::optional<MapAlignment> alignment;
     std::optional<size_t> map_points_used;
 };
 
@@ -81,7 +117,7 @@ struct EstimatedTrajectory {
 
 /// @brief Reads each scan of `source` and registers it; with a recording's IMU, predicts each
 /// scan's rotation by its gyro (registration::Odometry::PredictRotationBy) and, unless the
-/// session starts in a stored map (OdometryOptions::in_map), turns the poses level by its
+/// session starts in a stored map (OdometryOptions::start), turns the poses level by its
 /// accelerometer (registration::LevelFromAccelerometer).
 /// @throw RefusedError naming the scan and why ("scan 12 (<file>): too little overlap ...")
 /// when one cannot be registered and `skip_failures` is false, or when no scan was registered;
