@@ -27,9 +27,6 @@ namespace {
 
 using store::MapStore;
 
-/// T_map_source from a (4, 4) / (3, 4) pose or (x, y, z, yaw_deg).
-Eigen::Isometry3d GuessFrom(const py::object& init) { return GuessFromArray(init, "init"); }
-
 /// Products are stored for the newest map of a map open for writing: checked before the work.
 void CheckSave(const MapStore& store, const std::string& as_of, const std::string& what) {
     if (!as_of.empty()) {
@@ -81,7 +78,7 @@ py::dict Register(const StoredMap& m, const py::array& points, const py::object&
     options.config.min_overlap = min_overlap;
     options.config.max_rmse_m = max_rmse;
     const Eigen::Isometry3d guess =
-        init.is_none() ? Eigen::Isometry3d::Identity() : GuessFrom(init);
+        init.is_none() ? Eigen::Isometry3d::Identity() : GuessFromArray(init, "init");
     const MapStore& store = m.Get();
     pipeline::MapAlignment a;
     {
@@ -102,7 +99,7 @@ py::dict Localize(const StoredMap& m, const py::array& points, int floor, const 
     options.floor = floor;
     options.slice.l1_m = l1;
     options.slice.l2_m = l2;
-    if (!init.is_none()) options.guess = GuessFrom(init);
+    if (!init.is_none()) options.guess = GuessFromArray(init, "init");
     options.align.min_range_m = min_range;
     options.align.max_range_m = max_range;
     if (!min_overlap.is_none()) options.align.config.min_overlap = min_overlap.cast<double>();

@@ -152,8 +152,8 @@ registration::OdometryStep SessionOdometry::Register(const core::Scan& scan) {
 }
 
 void SessionOdometry::PredictRotationBy(registration::Gyro gyro) {
-    if (state_->odometry) state_->odometry->PredictRotationBy(gyro);
     state_->gyro = std::move(gyro);
+    if (state_->odometry) state_->odometry->PredictRotationBy(*state_->gyro);
 }
 
 const std::vector<Eigen::Isometry3d>& SessionOdometry::poses() const {
