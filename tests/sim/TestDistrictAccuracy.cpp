@@ -44,8 +44,12 @@ constexpr double kMinMeanIoU = 0.9;
 constexpr double kMinMatchedFractionGeometric = 0.8;  // the garage's
 constexpr size_t kMaxFalseVehiclesGeometric = 70;
 constexpr double kMinMeanIoUGeometric = 0.75;
-// What the small district measured (docs/simulator.md, "Districts"), held exactly: the scene, the
-// simulator and the analyses are deterministic (gcc 12 and clang 14 give the same counts).
+// What the small district measured (docs/simulator.md, "Districts"): the scene, the simulator and
+// the analyses give the same counts from run to run and from gcc 12 and clang 14 on one machine,
+// but another CPU model's scans differ by a few points (TestDistrictScans.cpp), and a box near
+// the IoU bar may cross it (an AMD EPYC of family 25: 99 geometric boxes matched, 2026-12-07).
+// Each count holds within kCountAcrossCpus.
+constexpr size_t kCountAcrossCpus = 2;
 constexpr size_t kWallsFound = 42;  // of 43: b1_1_n1's front is half hidden by parked vans
 constexpr size_t kVegetationAsWall = 1;
 constexpr size_t kLabelBoxesMatched = 120, kLabelFalseBoxes = 0;
@@ -59,6 +63,12 @@ constexpr size_t kFarBoxes = 40, kFarBoxesAtFacades = 23;
 constexpr double kMinPrecision = 0.95;  // the change targets, as for the two-session street
 constexpr double kMinRecall = 0.95;
 constexpr double kMinIoU = 0.9;
+
+// A count the small district measured, held within kCountAcrossCpus.
+void ExpectCount(size_t measured, size_t expected, const char* what) {
+    EXPECT_LE(measured, expected + kCountAcrossCpus) << what;
+    EXPECT_GE(measured + kCountAcrossCpus, expected) << what;
+}
 
 struct District {
     size_t tiles = 0;
@@ -139,8 +149,8 @@ void ExpectWallSlantsAsOnTheStreet(const District& d) {
     EXPECT_LE(s.max_error, kMaxSlantErrorDeg);
     EXPECT_LE(s.vegetation_as_wall, kMaxVegetationAsWall * static_cast<double>(s.vegetation));
     EXPECT_GE(s.vegetation, 10U) << "the district's trees and bushes are looked at";
-    EXPECT_EQ(s.found, kWallsFound);
-    EXPECT_EQ(s.vegetation_as_wall, kVegetationAsWall);
+    ExpectCount(s.found, kWallsFound, "walls found");
+    ExpectCount(s.vegetation_as_wall, kVegetationAsWall, "vegetation parts taken for walls");
 }
 
 double DistanceXy(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -196,16 +206,18 @@ void ExpectVehicleBoxesAsInTheGarage(const District& d) {
                                  static_cast<double>(s.truth));
         EXPECT_LE(s.false_positives, labels ? kMaxFalseVehicles : kMaxFalseVehiclesGeometric);
         EXPECT_GE(s.mean_iou, labels ? kMinMeanIoU : kMinMeanIoUGeometric);
-        EXPECT_EQ(s.matched, labels ? kLabelBoxesMatched : kGeometricBoxesMatched);
-        EXPECT_EQ(s.false_positives, labels ? kLabelFalseBoxes : kGeometricFalseBoxes);
+        ExpectCount(s.matched, labels ? kLabelBoxesMatched : kGeometricBoxesMatched,
+                    "boxes matched");
+        ExpectCount(s.false_positives, labels ? kLabelFalseBoxes : kGeometricFalseBoxes,
+                    "false boxes");
         if (labels) continue;
         const auto [far, at_facades] = FarBoxes(d, result);
         std::printf(
             "[ district ] geometric boxes more than %.1f m from every car: %zu, %zu of them "
             "within %.1f m of a facade\n",
             kFarFromCarsM, far, at_facades, kNearFacadeM);
-        EXPECT_EQ(far, kFarBoxes);
-        EXPECT_EQ(at_facades, kFarBoxesAtFacades);
+        ExpectCount(far, kFarBoxes, "boxes far from every car");
+        ExpectCount(at_facades, kFarBoxesAtFacades, "far boxes at facades");
     }
 }
 

@@ -50,13 +50,20 @@ TEST(District, SmallVariantSimulatesTheSameScansForTheSameSeed) {
     const auto a = strata::test::TempPath("district_a"), b = strata::test::TempPath("district_b");
     const SimulateReport first = SimulateSceneToSequence(spec, a, config);
     const SimulateReport second = SimulateSceneToSequence(spec, b, config);
-    const size_t kPoints[3] = {198255, 198115, 226553};  // per session, 2 HDL-64E scans each
+    // Per session, 2 HDL-64E scans each, as measured on the machines the scene was made on. Two
+    // runs on one machine are identical (above); another CPU model may give a few points more or
+    // fewer (an AMD EPYC of family 25: 4, 4 and 1 fewer, 2026-12-07; docs/simulator.md,
+    // "Districts"), so the measured counts hold within kPointsAcrossCpus.
+    const size_t kPoints[3] = {198255, 198115, 226553};
+    constexpr double kPointsAcrossCpus = 10;
     ASSERT_EQ(first.sessions.size(), 3U);
     for (size_t s = 0; s < 3; ++s) {
         const std::string session = "session_" + std::to_string(s);
         std::printf("[ district ] %s: %zu points\n", session.c_str(), first.sessions[s].points);
         EXPECT_EQ(first.sessions[s].points, second.sessions[s].points);
-        EXPECT_EQ(first.sessions[s].points, kPoints[s]) << session;
+        EXPECT_NEAR(static_cast<double>(first.sessions[s].points), static_cast<double>(kPoints[s]),
+                    kPointsAcrossCpus)
+            << session;
         for (const char* f : {"velodyne/000000.bin", "velodyne/000001.bin", "labels/000001.label",
                               "poses.txt", "ground_truth.json"}) {
             const std::string bytes = Slurp(a / session / f);
