@@ -1,9 +1,9 @@
 # Store overhead over in-memory integration, memory budget, one-tile reads, sessions 1..50,
 # reads by kind, format-4 migration (docs/bench.md, Store).
 add_executable(bench_store ${CMAKE_CURRENT_LIST_DIR}/bench_store.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/StoreSessions.cpp ${PROJECT_SOURCE_DIR}/tests/support/Format4Map.cpp)
-target_link_libraries(bench_store PRIVATE Strata::store Strata::io strata_test_support TBB::tbb
-  SQLite::SQLite3 PkgConfig::XXHASH)
+  ${CMAKE_CURRENT_LIST_DIR}/StoreSessions.cpp)
+target_link_libraries(bench_store PRIVATE Strata::store Strata::io strata_test_support
+  strata_format4_map TBB::tbb SQLite::SQLite3 PkgConfig::XXHASH)
 strata_use_build_paths(bench_store)
 strata_set_warnings(bench_store)
 # The short run checks the targets in CI (about 1-2 minutes on 2 cores); the full run writes
