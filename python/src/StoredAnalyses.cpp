@@ -41,12 +41,30 @@ void CheckSave(const MapStore& store, const std::string& as_of, const std::strin
     }
 }
 
+/// An analysis's memory budget as the program's --memory-budget takes it (MB, 0: no limit), in
+/// bytes.
+size_t BudgetBytes(double memory_budget_mb) {
+    if (!(memory_budget_mb >= 0.0) || !std::isfinite(memory_budget_mb)) {
+        throw InvalidArgumentError("memory_budget_mb must be a number >= 0 (0: no limit)");
+    }
+    return static_cast<size_t>(memory_budget_mb * 1e6);
+}
+
 /// The end of an analysis that edits the map (vehicles, dynamic): with `save`, `store()` commits
 /// the edited map (its leaves move into the store: the caller reads it back from there) and the
 /// report gets "commit"; otherwise the report gets the edited map itself, read-only, as "map".
+/// A map read tile by tile (`whole` false) has no edited map to hand over: "map" is None, with
+/// `save` too (the stored map would not fit the budget either). Read whole and stored, the report
+/// has no "map" (the program's path in it is dropped): Python's Map reads the stored map back.
 template <typename Outcome, typename StoreFn>
 py::dict StoreOrHandOver(const StoredMap& m, py::dict report,
-                         const std::shared_ptr<Outcome>& outcome, bool save, StoreFn&& store) {
+                         const std::shared_ptr<Outcome>& outcome, bool whole, bool save,
+                         StoreFn&& store) {
+    if (!whole) {
+        report["map"] = py::none();
+    } else if (save) {
+        report.attr("pop")("map", py::none());
+    }
     if (save) {
         int64_t commit = 0;
         {
@@ -56,6 +74,7 @@ py::dict StoreOrHandOver(const StoredMap& m, py::dict report,
         report["commit"] = commit;
         return report;
     }
+    if (!whole) return report;
     MemoryMap edited;
     edited.map = std::shared_ptr<core::VoxelMap>(outcome, &outcome->cleaned);
     edited.config = m.config;
@@ -116,15 +135,18 @@ py::dict Localize(const StoredMap& m, const py::array& points, int floor, const 
     return report;
 }
 
-py::dict Walls(const StoredMap& m, const std::string& as_of, bool save, const py::kwargs& options) {
+py::dict Walls(const StoredMap& m, const std::string& as_of, double memory_budget_mb, bool save,
+               const py::kwargs& options) {
     const walls::WallConfig config = WallConfigFrom(options);
+    const size_t budget = BudgetBytes(memory_budget_mb);
     MapStore& store = m.Get();
     if (save) CheckSave(store, as_of, "walls");
     pipeline::WallsOutcome outcome;
     int64_t commit = 0;
     {
         py::gil_scoped_release release;
-        outcome = pipeline::FindWalls(store, pipeline::SelectSnapshot(store, as_of), config);
+        outcome =
+            pipeline::FindWalls(store, pipeline::SelectSnapshot(store, as_of), config, budget);
         if (save) commit = pipeline::StoreWalls(store, outcome);
     }
     py::dict report = WallsReport(outcome.map, outcome.result, config);
@@ -133,42 +155,45 @@ py::dict Walls(const StoredMap& m, const std::string& as_of, bool save, const py
 }
 
 py::dict Vehicles(const StoredMap& m, const std::string& as_of, const std::string& source,
-                  bool ray_check, bool refill, bool save) {
+                  bool ray_check, bool refill, double memory_budget_mb, bool save) {
     vehicles::VehicleConfig config;
     config.source = vehicles::SourceFromName(source);
     config.ray_check = ray_check;
     config.refill = refill;
+    const size_t budget = BudgetBytes(memory_budget_mb);
     MapStore& store = m.Get();
     if (save) CheckSave(store, as_of, "vehicles");
     auto outcome = std::make_shared<pipeline::VehiclesOutcome>();
     {
         py::gil_scoped_release release;
-        *outcome = pipeline::ClearVehicles(store, pipeline::SelectSnapshot(store, as_of), config);
+        *outcome =
+            pipeline::ClearVehicles(store, pipeline::SelectSnapshot(store, as_of), config, budget);
     }
-    py::dict report = ParseJson(vehicles::VehiclesJson(outcome->result, outcome->cleaned.origin));
-    return StoreOrHandOver(m, std::move(report), outcome, save,
+    py::dict report = ParseJson(vehicles::VehiclesJson(outcome->result, store.settings().origin));
+    return StoreOrHandOver(m, std::move(report), outcome, outcome->tile_groups == 0, save,
                            [&] { return pipeline::StoreVehicles(store, *outcome); });
 }
 
 py::dict Dynamic(const StoredMap& m, const std::string& as_of, const std::string& session,
                  int margin, bool faces, size_t min_object, bool occupied_too,
-                 bool remove_scattered, bool save) {
+                 bool remove_scattered, double memory_budget_mb, bool save) {
     dynamic::DynamicConfig config;
     config.margin_voxels = margin;
     config.neighbourhood = faces ? dynamic::Neighbourhood::kFaces : dynamic::Neighbourhood::kCube;
     config.min_object_voxels = min_object;
     config.occupied_too = occupied_too;
     config.keep_scattered = !remove_scattered;
+    const size_t budget = BudgetBytes(memory_budget_mb);
     MapStore& store = m.Get();
     if (save) CheckSave(store, as_of, "static map");
     auto outcome = std::make_shared<pipeline::DynamicOutcome>();
     {
         py::gil_scoped_release release;
-        *outcome =
-            pipeline::FindDynamic(store, pipeline::SelectSnapshot(store, as_of), config, session);
+        *outcome = pipeline::FindDynamic(store, pipeline::SelectSnapshot(store, as_of), config,
+                                         session, budget);
     }
     py::dict report = ParseJson(pipeline::DynamicReport(*outcome, store));
-    return StoreOrHandOver(m, std::move(report), outcome, save,
+    return StoreOrHandOver(m, std::move(report), outcome, outcome->tiles == 0, save,
                            [&] { return pipeline::StoreDynamic(store, *outcome); });
 }
 
@@ -226,11 +251,11 @@ void AddStoredAnalyses(py::class_<StoredMap>& cls) {
             py::arg("class_name"), py::arg("min_voxels"), py::arg("gap"), py::arg("tolerance"),
             py::arg("margin"), py::arg("grow"), py::arg("support"))
         .def("vehicles", &Vehicles, py::arg("as_of"), py::arg("source"), py::arg("ray_check"),
-             py::arg("refill"), py::arg("save"))
+             py::arg("refill"), py::arg("memory_budget_mb"), py::arg("save"))
         .def("dynamic", &Dynamic, py::arg("as_of"), py::arg("session"), py::arg("margin"),
              py::arg("faces"), py::arg("min_object"), py::arg("occupied_too"),
-             py::arg("remove_scattered"), py::arg("save"))
-        .def("walls", &Walls, py::arg("as_of"), py::arg("save"))
+             py::arg("remove_scattered"), py::arg("memory_budget_mb"), py::arg("save"))
+        .def("walls", &Walls, py::arg("as_of"), py::arg("memory_budget_mb"), py::arg("save"))
         .def("register", &Register, py::arg("points"), py::arg("init"), py::arg("as_of"),
              py::arg("margin"), py::arg("min_range"), py::arg("max_range"), py::arg("min_overlap"),
              py::arg("max_rmse"))

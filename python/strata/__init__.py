@@ -296,20 +296,25 @@ class Map:
         """VoxelMap.columns on the newest state."""
         return self.snapshot().columns(window)
 
-    def walls(self, as_of=None, save: bool = False, **options) -> dict:
+    def walls(self, as_of=None, save: bool = False, memory_budget_mb: float = 512.0,
+              **options) -> dict:
         """Walls and their slant angles (docs/walls.md) of the newest state (or as of a
         session), as `strata walls --json` reports them (walls, stats, config, ...), plus
         "voxels": the centre, slant_deg and wall_id of every wall voxel as arrays. Options are
-        WallConfig's fields (window_m=1.5, level_to_ground=True, ...).
+        WallConfig's fields (window_m=1.5, level_to_ground=True, ...). memory_budget_mb: as
+        the program's --memory-budget (0: no limit), a map that does not fit is read a group of
+        tiles at a time, with the same walls.
 
         save=True stores them in the map as `strata walls` does (one commit: the slant_deg and
         wall_id grids and the walls table, `SELECT * FROM walls`) and adds "commit"; it needs
         the map open for writing and no as_of. Bad options are refused before anything is
         read or written."""
-        return self._impl.walls("" if as_of is None else str(as_of), save, **options)
+        return self._impl.walls("" if as_of is None else str(as_of), memory_budget_mb, save,
+                                **options)
 
     def vehicles(self, as_of=None, source: str = "auto", ray_check: bool = True,
-                 refill: bool = True, save: bool = False) -> dict:
+                 refill: bool = True, save: bool = False,
+                 memory_budget_mb: float = 512.0) -> dict:
         """Parked vehicles cleared and the ground under them refilled (docs/vehicles.md), as
         `strata vehicles --json` reports them: vehicles [{id, center, size, yaw_deg, source,
         cleared_voxels, refilled_cells, refused_cells}], ... plus "map": the cleaned map as a
@@ -319,17 +324,27 @@ class Map:
         as `strata vehicles` does (one commit: the cleaned map, the vehicle_cleared and
         vehicle_refilled grids and the vehicles table; as_of the previous session still shows
         the map as it was) and adds "commit"; "map" is then the map as stored. It needs the map
-        open for writing and no as_of."""
+        open for writing and no as_of.
+
+        memory_budget_mb: as the program's --memory-budget (0: no limit), a map that does not
+        fit is read tile by tile, with the same vehicles; "map" is then None (save=True still
+        stores the cleaned map, tile by tile)."""
         report = self._impl.vehicles("" if as_of is None else str(as_of), source, ray_check,
-                                     refill, save)
+                                     refill, memory_budget_mb, save)
+        return self._stored(report, save)
+
+    def _stored(self, report: dict, save: bool) -> dict:
+        """An edited map's report after save=True: the map as stored, read again (unless the
+        analysis read it tile by tile: "map" None)."""
         if save:
             self._newest = None
-            report["map"] = self.snapshot()
+            if "map" not in report:
+                report["map"] = self.snapshot()
         return report
 
     def dynamic(self, as_of=None, session=None, margin: int = 1, faces: bool = False,
                 min_object: int = 8, occupied_too: bool = False, remove_scattered: bool = False,
-                save: bool = False) -> dict:
+                save: bool = False, memory_budget_mb: float = 512.0) -> dict:
         """What moved taken out of the map (docs/dynamic.md), as `strata dynamic --json`
         reports it: objects [{object_id, voxels, min_x, ..., max_z, sessions}], removed_voxels,
         restored_voxels, static_voxels, ... plus "map": the static map as a read-only VoxelMap.
@@ -341,14 +356,17 @@ class Map:
         as `strata dynamic` does (one commit: the static map, the dynamic_removed and
         dynamic_restored grids and the dynamic table; as_of the last session still shows the
         map as it was) and adds "commit"; "map" is then the map as stored. It needs the map open
-        for writing and no as_of."""
+        for writing and no as_of.
+
+        memory_budget_mb: as the program's --memory-budget (0: no limit), a map whose tiles and
+        session layers do not fit is judged a tile at a time with its neighbours' layers, with
+        the same result (docs/dynamic.md, "Tile by tile"); "map" is then None (save=True still
+        stores the static map, tile by tile)."""
         report = self._impl.dynamic("" if as_of is None else str(as_of),
                                     "" if session is None else str(session), margin, faces,
-                                    min_object, occupied_too, remove_scattered, save)
-        if save:
-            self._newest = None
-            report["map"] = self.snapshot()
-        return report
+                                    min_object, occupied_too, remove_scattered, memory_budget_mb,
+                                    save)
+        return self._stored(report, save)
 
     def diff(self, a="map", b="map", region=None, class_name: str = "", min_voxels: int = 8,
              gap: int = 1, tolerance: int = 2, margin: int = 1, grow: int = 2,
