@@ -4,8 +4,11 @@
 // its documented figures (kDocumented).
 //
 //   bench_integration [DATA_DIR] [--scans N] [--voxel S ...] [--strata-only] [--counts] [--ci]
-//                     [--narrow]
+//                     [--narrow] [--repeat N]
 //
+// --repeat N: the full run times each engine (and the whole command) N times, each in a process
+// of its own, and reports the median, with the runs' spread below the row (KITTI 00's six scans
+// moved by 15 % between single runs).
 // --narrow: walk one ray at a time where the processor could walk four (IntegrationConfig's
 // wide_walk off), to measure what the wide walk is worth.
 // --counts: also DDA steps and unique voxels per scan (for callgrind's instructions per step).
@@ -254,16 +257,45 @@ Run TimeInChild(const fs::path& data, const char* dataset, const std::string& en
     return run;
 }
 
-// The fastest of `repeats` timed runs in children: another process on a shared machine only
-// ever slows a run, so the fastest is the one least disturbed.
-Run FastestInChild(const fs::path& data, const char* dataset, const std::string& engine,
-                   double voxel, size_t scans, bool wide, int repeats) {
-    Run best = TimeInChild(data, dataset, engine, voxel, scans, wide);
-    for (int i = 1; i < repeats; ++i) {
-        const Run run = TimeInChild(data, dataset, engine, voxel, scans, wide);
-        if (run.ms_per_scan < best.ms_per_scan) best = run;
+// `repeats` timed runs in children, in the order they ran.
+struct Runs {
+    std::vector<Run> runs;
+
+    // The fastest: another process on a shared machine only ever slows a run, so the fastest is
+    // the one least disturbed (the short run's few scans).
+    [[nodiscard]] Run Fastest() const {
+        return *std::min_element(runs.begin(), runs.end(), [](const Run& a, const Run& b) {
+            return a.ms_per_scan < b.ms_per_scan;
+        });
     }
-    return best;
+    // The median time (the full run's --repeat), memory as measured (deterministic).
+    [[nodiscard]] Run Median() const {
+        Run run = runs.front();
+        run.ms_per_scan = strata::bench::Median(Times());
+        return run;
+    }
+    [[nodiscard]] std::vector<double> Times() const {
+        std::vector<double> ms;
+        for (const Run& r : runs) ms.push_back(r.ms_per_scan);
+        return ms;
+    }
+};
+
+Runs TimeInChildren(const fs::path& data, const char* dataset, const std::string& engine,
+                    double voxel, size_t scans, bool wide, int repeats) {
+    Runs out;
+    for (int i = 0; i < repeats; ++i) {
+        out.runs.push_back(TimeInChild(data, dataset, engine, voxel, scans, wide));
+    }
+    return out;
+}
+
+// "lo-hi" of the times, for the spread line under a row.
+std::string Spread(const std::vector<double>& times, int digits = 1) {
+    const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.*f-%.*f", digits, *lo, digits, *hi);
+    return text;
 }
 
 }  // namespace
@@ -275,6 +307,7 @@ int main(int argc, char** argv) {
     bool with_octomap = true;  // --strata-only: one thread, no OctoMap (for callgrind)
     bool counts = false, ci = false;
     bool wide = true;  // --narrow: walk one ray at a time even where four at a time can
+    int repeat = 1;    // --repeat: timed runs of each engine in the full run, the median kept
     std::string time_engine, time_dataset;  // --time, --dataset: one timed run (TimeAlone)
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -288,6 +321,8 @@ int main(int argc, char** argv) {
             counts = true;
         } else if (a == "--ci") {
             ci = true;
+        } else if (a == "--repeat" && i + 1 < argc) {
+            repeat = std::max(1, std::atoi(argv[++i]));
         } else if (a == "--voxel" && i + 1 < argc) {
             voxels.push_back(std::stod(argv[++i]));
         } else if (a == "--time" && i + 1 < argc) {
@@ -343,17 +378,32 @@ int main(int argc, char** argv) {
         auto map = strata::core::VoxelMap::Create(voxel);
         Run one = RunStrata(scans, 1, wide, map);
         Run octo, two = one;
+        std::string spread;  // the full run's --repeat: each engine's times, lowest to highest
         if (with_octomap) {
             octo = RunOctomap(scans, tree);
             // The short run keeps OctoMap's time from this process, where it runs after strata
             // (1-4 % slower, TimeAlone), well inside kSlack: a second OctoMap run in a child
             // would cost CI as much again (1.3-3 s a scan at 0.1 m). strata's runs are short
             // (a few scans), so it takes the fastest of kCiRepeats, the machine being shared.
-            if (!ci)
-                octo.ms_per_scan = TimeInChild(data, name, "octomap", voxel, n, wide).ms_per_scan;
-            const int repeats = ci ? kCiRepeats : 1;
-            one.ms_per_scan = FastestInChild(data, name, "1", voxel, n, wide, repeats).ms_per_scan;
-            two = FastestInChild(data, name, "2", voxel, n, wide, repeats);
+            // The full run takes the median of --repeat runs of each.
+            if (ci) {
+                one.ms_per_scan = TimeInChildren(data, name, "1", voxel, n, wide, kCiRepeats)
+                                      .Fastest()
+                                      .ms_per_scan;
+                two = TimeInChildren(data, name, "2", voxel, n, wide, kCiRepeats).Fastest();
+            } else {
+                const Runs o = TimeInChildren(data, name, "octomap", voxel, n, wide, repeat);
+                const Runs s1 = TimeInChildren(data, name, "1", voxel, n, wide, repeat);
+                const Runs s2 = TimeInChildren(data, name, "2", voxel, n, wide, repeat);
+                octo.ms_per_scan = o.Median().ms_per_scan;
+                one.ms_per_scan = s1.Median().ms_per_scan;
+                two = s2.Median();
+                if (repeat > 1) {
+                    spread = "  medians of " + std::to_string(repeat) +
+                             " runs; ms a scan, OctoMap " + Spread(o.Times()) + ", strata 1T " +
+                             Spread(s1.Times()) + ", 2T " + Spread(s2.Times());
+                }
+            }
         }
         const double pts_per_scan = static_cast<double>(n_points) / scans.size();
         const double speedup = octo.ms_per_scan / one.ms_per_scan;
@@ -373,6 +423,7 @@ int main(int argc, char** argv) {
             two.ms_per_scan, one.ms_per_scan / two.ms_per_scan,
             pts_per_scan / one.ms_per_scan / 1e3, octo.mem_mb, one.mem_mb, jaccard_occ,
             jaccard_free, differing);
+        if (!spread.empty()) std::printf("%s\n", spread.c_str());
         if (counts) {
             double steps = 0.0;
             for (const auto& s : scans) steps += DdaSteps(s, voxel);
@@ -410,13 +461,14 @@ int main(int argc, char** argv) {
             }
         }
         if (with_octomap && voxel == 0.2) {
-            // The fastest of as many runs as strata's in-process time took.
-            const int repeats = ci ? kCiRepeats : 1;
+            // As strata's in-process time: the fastest of kCiRepeats, or the median of --repeat.
             const size_t read = scans.size();  // all of them when `n` is more
-            double whole_s = TimeWholeCommand(dir, voxel, read);
-            for (int i = 1; i < repeats; ++i) {
-                whole_s = std::min(whole_s, TimeWholeCommand(dir, voxel, read));
+            std::vector<double> whole_runs;
+            for (int i = 0; i < (ci ? kCiRepeats : repeat); ++i) {
+                whole_runs.push_back(TimeWholeCommand(dir, voxel, read));
             }
+            const double whole_s = ci ? *std::min_element(whole_runs.begin(), whole_runs.end())
+                                      : strata::bench::Median(whole_runs);
             const double octo_s = octo.ms_per_scan * static_cast<double>(read) / 1e3;
             const double kernel_s = one.ms_per_scan * static_cast<double>(read) / 1e3;
             const double whole_speedup = octo_s / whole_s;
@@ -426,6 +478,10 @@ int main(int argc, char** argv) {
                           scans.size(), whole_s, kernel_s, whole_s / kernel_s, octo_s,
                           whole_speedup);
             whole_rows.emplace_back(text);
+            if (!ci && repeat > 1) {
+                whole_rows.push_back("  median of " + std::to_string(repeat) +
+                                     " runs: " + Spread(whole_runs, 3) + " s");
+            }
             if (doc != nullptr && whole_speedup < doc->whole_speedup / kSlack) {
                 std::fprintf(stderr,
                              "FAIL %s %.2f: strata integrate %.1fx OctoMap's insert, below the "
