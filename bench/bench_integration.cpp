@@ -257,37 +257,21 @@ Run TimeInChild(const fs::path& data, const char* dataset, const std::string& en
     return run;
 }
 
-// `repeats` timed runs in children, in the order they ran.
-struct Runs {
-    std::vector<Run> runs;
-
-    // The fastest: another process on a shared machine only ever slows a run, so the fastest is
-    // the one least disturbed (the short run's few scans).
-    [[nodiscard]] Run Fastest() const {
-        return *std::min_element(runs.begin(), runs.end(), [](const Run& a, const Run& b) {
-            return a.ms_per_scan < b.ms_per_scan;
-        });
-    }
-    // The median time (the full run's --repeat), memory as measured (deterministic).
-    [[nodiscard]] Run Median() const {
-        Run run = runs.front();
-        run.ms_per_scan = strata::bench::Median(Times());
-        return run;
-    }
-    [[nodiscard]] std::vector<double> Times() const {
-        std::vector<double> ms;
-        for (const Run& r : runs) ms.push_back(r.ms_per_scan);
-        return ms;
-    }
-};
-
-Runs TimeInChildren(const fs::path& data, const char* dataset, const std::string& engine,
-                    double voxel, size_t scans, bool wide, int repeats) {
-    Runs out;
+// The times (ms a scan) of `repeats` timed runs in children, in the order they ran.
+std::vector<double> TimesInChildren(const fs::path& data, const char* dataset,
+                                    const std::string& engine, double voxel, size_t scans,
+                                    bool wide, int repeats) {
+    std::vector<double> ms;
     for (int i = 0; i < repeats; ++i) {
-        out.runs.push_back(TimeInChild(data, dataset, engine, voxel, scans, wide));
+        ms.push_back(TimeInChild(data, dataset, engine, voxel, scans, wide).ms_per_scan);
     }
-    return out;
+    return ms;
+}
+
+// The time a row reports: in the short run the fastest (another process on a shared machine only
+// ever slows a run, so the fastest is the one least disturbed), in the full run the median.
+double Kept(const std::vector<double>& times, bool ci) {
+    return ci ? *std::min_element(times.begin(), times.end()) : strata::bench::Median(times);
 }
 
 // "lo-hi" of the times, for the spread line under a row.
@@ -386,23 +370,18 @@ int main(int argc, char** argv) {
             // would cost CI as much again (1.3-3 s a scan at 0.1 m). strata's runs are short
             // (a few scans), so it takes the fastest of kCiRepeats, the machine being shared.
             // The full run takes the median of --repeat runs of each.
-            if (ci) {
-                one.ms_per_scan = TimeInChildren(data, name, "1", voxel, n, wide, kCiRepeats)
-                                      .Fastest()
-                                      .ms_per_scan;
-                two = TimeInChildren(data, name, "2", voxel, n, wide, kCiRepeats).Fastest();
-            } else {
-                const Runs o = TimeInChildren(data, name, "octomap", voxel, n, wide, repeat);
-                const Runs s1 = TimeInChildren(data, name, "1", voxel, n, wide, repeat);
-                const Runs s2 = TimeInChildren(data, name, "2", voxel, n, wide, repeat);
-                octo.ms_per_scan = o.Median().ms_per_scan;
-                one.ms_per_scan = s1.Median().ms_per_scan;
-                two = s2.Median();
-                if (repeat > 1) {
-                    spread = "  medians of " + std::to_string(repeat) +
-                             " runs; ms a scan, OctoMap " + Spread(o.Times()) + ", strata 1T " +
-                             Spread(s1.Times()) + ", 2T " + Spread(s2.Times());
-                }
+            const int repeats = ci ? kCiRepeats : repeat;
+            std::vector<double> octo_ms;
+            if (!ci) octo_ms = TimesInChildren(data, name, "octomap", voxel, n, wide, repeats);
+            const auto one_ms = TimesInChildren(data, name, "1", voxel, n, wide, repeats);
+            const auto two_ms = TimesInChildren(data, name, "2", voxel, n, wide, repeats);
+            if (!ci) octo.ms_per_scan = Kept(octo_ms, ci);
+            one.ms_per_scan = Kept(one_ms, ci);
+            two.ms_per_scan = Kept(two_ms, ci);
+            if (!ci && repeat > 1) {
+                spread = "  medians of " + std::to_string(repeat) + " runs; ms a scan, OctoMap " +
+                         Spread(octo_ms) + ", strata 1T " + Spread(one_ms) + ", 2T " +
+                         Spread(two_ms);
             }
         }
         const double pts_per_scan = static_cast<double>(n_points) / scans.size();
@@ -467,8 +446,7 @@ int main(int argc, char** argv) {
             for (int i = 0; i < (ci ? kCiRepeats : repeat); ++i) {
                 whole_runs.push_back(TimeWholeCommand(dir, voxel, read));
             }
-            const double whole_s = ci ? *std::min_element(whole_runs.begin(), whole_runs.end())
-                                      : strata::bench::Median(whole_runs);
+            const double whole_s = Kept(whole_runs, ci);
             const double octo_s = octo.ms_per_scan * static_cast<double>(read) / 1e3;
             const double kernel_s = one.ms_per_scan * static_cast<double>(read) / 1e3;
             const double whole_speedup = octo_s / whole_s;
