@@ -6,59 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "EmbreeScene.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/geometry/KdTree.hpp"
 
 namespace strata::sim {
 
 namespace {
-
-// Nearest-neighbour distances to a point set bucketed in small cubes: a query searches shells
-// of cubes outwards until no nearer point can remain; beyond `max_distance` it returns that.
-class PointBuckets {
-public:
-    PointBuckets(const std::vector<Eigen::Vector3d>& points, double cell, double max_distance)
-        : cell_(cell), max_distance_(max_distance) {
-        for (const Eigen::Vector3d& p : points) buckets_[Key(Cell(p))].push_back(p);
-    }
-    [[nodiscard]] double Nearest(const Eigen::Vector3d& q) const {
-        const Eigen::Vector3i c = Cell(q);
-        double best2 = max_distance_ * max_distance_;
-        const int shells = static_cast<int>(std::ceil(max_distance_ / cell_)) + 1;
-        for (int r = 0; r <= shells; ++r) {
-            // Points in shell r are at least (r - 1) cells away.
-            const double reach = std::max(0, r - 1) * cell_;
-            if (reach * reach >= best2) break;
-            for (int dz = -r; dz <= r; ++dz) {
-                for (int dy = -r; dy <= r; ++dy) {
-                    for (int dx = -r; dx <= r; ++dx) {
-                        if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
-                        const auto it = buckets_.find(Key(c + Eigen::Vector3i(dx, dy, dz)));
-                        if (it == buckets_.end()) continue;
-                        for (const Eigen::Vector3d& p : it->second) {
-                            best2 = std::min(best2, (p - q).squaredNorm());
-                        }
-                    }
-                }
-            }
-        }
-        return std::sqrt(best2);
-    }
-
-private:
-    [[nodiscard]] Eigen::Vector3i Cell(const Eigen::Vector3d& p) const {
-        return (p / cell_).array().floor().cast<int>();
-    }
-    static int64_t Key(const Eigen::Vector3i& c) {
-        return (int64_t(c.x()) & 0x1FFFFF) | ((int64_t(c.y()) & 0x1FFFFF) << 21) |
-               ((int64_t(c.z()) & 0x1FFFFF) << 42);
-    }
-    double cell_;
-    double max_distance_;
-    std::unordered_map<int64_t, std::vector<Eigen::Vector3d>> buckets_;
-};
 
 // Sum of distances and count within the threshold.
 struct Tally {
@@ -109,9 +64,12 @@ SurfaceScore ScoreSurface(const std::vector<Eigen::Vector3d>& map_points, const 
     const Tally to_surface = Measure(map_points, threshold_m, [&](const Eigen::Vector3d& p) {
         return std::min<double>(surface.ClosestDistance(p.cast<float>(), cap), max_distance_m);
     });
-    const PointBuckets map(map_points, threshold_m, max_distance_m);
-    const Tally to_map = Measure(reference_points, threshold_m,
-                                 [&](const Eigen::Vector3d& p) { return map.Nearest(p); });
+    const geometry::KdTree map(map_points);
+    const double max_d2 = max_distance_m * max_distance_m;
+    const Tally to_map = Measure(reference_points, threshold_m, [&](const Eigen::Vector3d& p) {
+        const long nearest = map.NearestWithin(p, max_d2);
+        return nearest < 0 ? max_distance_m : (map_points[size_t(nearest)] - p).norm();
+    });
 
     SurfaceScore s;
     s.map_points = map_points.size();

@@ -38,7 +38,7 @@ Eigen::Isometry3d Exp(const Eigen::Matrix<double, 6, 1>& x) {
 RawPointToPlane::RawPointToPlane(std::vector<Eigen::Vector3d> target, const RawIcpConfig& config)
     : config_(config) {
     // Normals from the k nearest raw points; only planar neighbourhoods keep their point.
-    const KdTree all(target);
+    const geometry::KdTree all(target);
     const auto k = static_cast<size_t>(config_.normal_neighbours);
     std::vector<Eigen::Vector3d> normals(target.size());
     std::vector<uint8_t> planar(target.size(), 0);
@@ -61,7 +61,7 @@ RawPointToPlane::RawPointToPlane(std::vector<Eigen::Vector3d> target, const RawI
         points_.push_back(target[i]);
         normals_.push_back(normals[i]);
     }
-    tree_ = std::make_unique<KdTree>(points_);
+    tree_.emplace(points_);
 }
 
 RawIcpResult RawPointToPlane::Align(const std::vector<Eigen::Vector3d>& source,

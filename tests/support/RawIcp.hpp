@@ -2,14 +2,15 @@
 // The independent reference for registration on real scans: a plain, robust point-to-plane ICP
 // on the raw points of two scans, written for the tests and sharing no code with strata's
 // RegisterPoints (no VDB, no Surface, no Ceres). Target normals from the PCA of the k nearest
-// raw points (kd-tree), correspondences by nearest raw point, Cauchy loss by iteratively
-// reweighted Gauss-Newton solved with Eigen.
+// raw points (strata::geometry's kd-tree, which registration does not use), correspondences by
+// nearest raw point, Cauchy loss by iteratively reweighted Gauss-Newton solved with Eigen.
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <vector>
 
-#include "KdTree.hpp"
+#include "strata/geometry/KdTree.hpp"
 
 namespace strata::registration::test {
 
@@ -48,7 +49,7 @@ private:
     RawIcpConfig config_;
     std::vector<Eigen::Vector3d> points_;
     std::vector<Eigen::Vector3d> normals_;
-    std::unique_ptr<KdTree> tree_;
+    std::optional<geometry::KdTree> tree_;
 };
 
 /// Translation (m) and rotation angle (deg) between two poses.
