@@ -131,4 +131,45 @@ VehicleScore ScoreVehicles(const ParkingCase& c, const core::VoxelMap& cleaned,
     return s;
 }
 
+namespace {
+
+struct DocumentedRow {
+    double voxel;
+    const char* name;
+    size_t matched, false_positives;
+    double mean_iou, accuracy_m, completeness_m, chamfer_m, fscore;
+};
+constexpr double kSlack = 2.5;
+constexpr DocumentedRow kDocumented[] = {
+    {0.05, "labels, cleared only", 43, 0, 0.93, 0.0083, 0.0636, 0.0360, 0.934},
+    {0.05, "labels, refill without ray check", 43, 0, 0.93, 0.0074, 0.0270, 0.0172, 0.992},
+    {0.05, "labels, cleared + refill", 43, 0, 0.93, 0.0074, 0.0269, 0.0172, 0.992},
+    {0.05, "no labels (geometric), cleared + refill", 38, 10, 0.89, 0.0366, 0.0281, 0.0324, 0.970},
+    {0.10, "labels, cleared only", 43, 0, 0.95, 0.0075, 0.0758, 0.0417, 0.930},
+    {0.10, "labels, cleared + refill", 43, 0, 0.95, 0.0071, 0.0413, 0.0242, 0.991},
+    {0.10, "no labels (geometric), cleared + refill", 37, 1, 0.87, 0.0145, 0.0431, 0.0288, 0.982},
+};
+
+}  // namespace
+
+std::vector<std::string> OffTheDocumentedRow(double voxel, const std::string& name,
+                                             const VehicleScore& s) {
+    std::vector<std::string> off;
+    for (const DocumentedRow& d : kDocumented) {
+        if (d.voxel != voxel || name != d.name) continue;
+        const sim::SurfaceScore& f = s.surface;
+        const auto check = [&](bool held, const char* what) {
+            if (!held) off.emplace_back(what);
+        };
+        check(s.matched == d.matched, "boxes matched");
+        check(s.false_positives == d.false_positives, "false positives");
+        check(1.0 - s.mean_iou <= kSlack * (1.0 - d.mean_iou), "mean IoU");
+        check(f.accuracy_m <= kSlack * d.accuracy_m, "accuracy");
+        check(f.completeness_m <= kSlack * d.completeness_m, "completeness");
+        check(f.chamfer_l1_m <= kSlack * d.chamfer_m, "Chamfer-L1");
+        check(1.0 - f.fscore <= kSlack * (1.0 - d.fscore), "F-score");
+    }
+    return off;
+}
+
 }  // namespace strata::testing
