@@ -75,11 +75,14 @@ TEST(KdTree, FindsWhatBruteForceFinds) {
         const Eigen::Vector3d again = points[size_t(i) * 7];
         points.push_back(again);
     }
-    for (int i = 0; i < 1000; ++i) points.emplace_back(double(i % 10), double(i / 10 % 10), double(i / 100));
+    for (int i = 0; i < 1000; ++i)
+        points.emplace_back(double(i % 10), double(i / 10 % 10), double(i / 100));
     const geometry::KdTree tree(points);
     ASSERT_EQ(tree.size(), points.size());
 
-    const auto d2 = [&](size_t i, const Eigen::Vector3d& q) { return (points[i] - q).squaredNorm(); };
+    const auto d2 = [&](size_t i, const Eigen::Vector3d& q) {
+        return (points[i] - q).squaredNorm();
+    };
     for (int t = 0; t < 500; ++t) {
         const Eigen::Vector3d q(u(rng), u(rng), u(rng));
         std::vector<double> all;
