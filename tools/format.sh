@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Formats the project's C++ with clang-format (Debian's clang-format 14, `.clang-format` at the
 # root: Google style, 4 spaces, 100 columns).
-# Usage: tools/format.sh [FILES...]           rewrite the files (default: every tracked .cpp/.hpp)
+# Usage: tools/format.sh [FILES...]           rewrite the files (default: every .cpp/.hpp that is
+#                                             tracked or not ignored: a new file before `git add`)
 #        tools/format.sh --check [FILES...]   change nothing; list the files that differ and exit 1
 #                                             when there are any (.ci/run)
 set -euo pipefail
@@ -18,7 +19,8 @@ if ! command -v clang-format >/dev/null; then
 fi
 files=("$@")
 if ((${#files[@]} == 0)); then
-  mapfile -t files < <(git ls-files '*.cpp' '*.hpp')
+  mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.cpp' '*.hpp' |
+                       while read -r f; do [[ -f $f ]] && echo "$f"; done)
 fi
 if ((!check)); then
   clang-format -i "${files[@]}"
