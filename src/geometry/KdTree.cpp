@@ -82,6 +82,7 @@ long KdTree::NearestWithin(const Eigen::Vector3d& q, double max_d2) const {
     // without a heap (this is the query ICP and the surface scores make per point).
     double best_d2 = max_d2;
     long best = -1;
+    // One entry a level: median splits of leaves of 8 make 64 levels for 2^66 points.
     size_t stack[64];
     double gap2[64];  // the squared distance to a far side's splitting plane
     int top = 0;

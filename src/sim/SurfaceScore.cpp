@@ -4,8 +4,6 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
-#include <cmath>
-#include <stdexcept>
 
 #include "EmbreeScene.hpp"
 #include "strata/core/Error.hpp"
