@@ -5,8 +5,10 @@
 // 0.05 deg target, a row of the first table errs by more than 2.5x what docs/registration.md
 // measured, or (unless --accuracy-only) localization takes more than issue 8's 20 ms a scan on
 // one core. CTest runs it with --accuracy-only (bench_registration.AccuracyTargets, label bench):
-// times are measured by hand. Without ../shared/data the real-data rows are left out and the
-// program exits 77 (CTest: skipped), 1 under STRATA_REQUIRE_DATA=1 (CI).
+// the first table only, without times. The pairs' 0.05 deg target is held in CI by the
+// RegistrationRealData tests, which register the same pairs from the same raw optimum with the
+// same configuration, at 0.03 deg (KITTI) and 0.05 deg (BALM). Without ../shared/data the real-data
+// rows are left out and the program exits 77 (CTest: skipped), 1 under STRATA_REQUIRE_DATA=1 (CI).
 //
 //   bench_registration [DATA_DIR] [--repeat N] [--accuracy-only]
 //
@@ -233,7 +235,8 @@ int main(int argc, char** argv) {
         fs::path missing;
         const int row_misses = Run(args.data, args.repeat, !args.accuracy_only, missing);
         std::printf("\n");
-        const int misses = strata::bench::PrintRegistrationPairs(args.data, args.repeat);
+        const int misses =
+            args.accuracy_only ? 0 : strata::bench::PrintRegistrationPairs(args.data, args.repeat);
         if (misses > 0) {
             std::fprintf(stderr, "bench_registration: %d pair(s) miss the 0.05 deg target\n",
                          misses);
