@@ -1,21 +1,37 @@
 #include "strata/geometry/KdTree.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <utility>
 
 namespace strata::geometry {
 
 namespace {
+
 constexpr size_t kLeafSize = 8;
-}  // namespace
 
-struct KdTree::Best {
+// The nearest point found so far, below a squared distance.
+struct Nearest {
+    double best_d2;
+    long best = -1;
+
+    [[nodiscard]] double Bound() const { return best_d2; }
+    void Offer(double d2, size_t i) {
+        if (d2 >= best_d2) return;
+        best_d2 = d2;
+        best = static_cast<long>(i);
+    }
+};
+
+// The k nearest points found so far: a max-heap of (squared distance, index).
+struct KBest {
     size_t k;
-    double max_d2;
-    std::vector<std::pair<double, size_t>> items;  // a max-heap by squared distance
+    std::vector<std::pair<double, size_t>> items;
 
-    [[nodiscard]] double Bound() const { return items.size() < k ? max_d2 : items.front().first; }
+    [[nodiscard]] double Bound() const {
+        return items.size() < k ? std::numeric_limits<double>::infinity() : items.front().first;
+    }
     void Offer(double d2, size_t i) {
         if (d2 >= Bound()) return;
         items.emplace_back(d2, i);
@@ -26,6 +42,8 @@ struct KdTree::Best {
         }
     }
 };
+
+}  // namespace
 
 KdTree::KdTree(const std::vector<Eigen::Vector3d>& points) {
     std::vector<size_t> order(points.size());
@@ -63,6 +81,7 @@ size_t KdTree::Build(std::vector<size_t>& order, size_t begin, size_t end,
     return id;
 }
 
+template <typename Best>
 void KdTree::Search(size_t id, const Eigen::Vector3d& q, Best& best) const {
     const Node& node = nodes_[id];
     if (node.axis < 0) {
@@ -77,40 +96,13 @@ void KdTree::Search(size_t id, const Eigen::Vector3d& q, Best& best) const {
 }
 
 long KdTree::NearestWithin(const Eigen::Vector3d& q, double max_d2) const {
-    if (nodes_.empty()) return -1;
-    // Descends with an explicit stack and one best pair: the same visits as Search with k = 1,
-    // without a heap (this is the query ICP and the surface scores make per point).
-    double best_d2 = max_d2;
-    long best = -1;
-    // One entry a level: median splits of leaves of 8 make 64 levels for 2^66 points.
-    size_t stack[64];
-    double gap2[64];  // the squared distance to a far side's splitting plane
-    int top = 0;
-    stack[top] = 0;
-    gap2[top++] = 0.0;
-    while (top > 0) {
-        --top;
-        if (gap2[top] >= best_d2) continue;
-        const Node* node = &nodes_[stack[top]];
-        while (node->axis >= 0) {
-            const double d = q(node->axis) - node->split;
-            stack[top] = d < 0.0 ? node->right : node->left;
-            gap2[top++] = d * d;
-            node = &nodes_[d < 0.0 ? node->left : node->right];
-        }
-        for (size_t i = node->begin; i < node->end; ++i) {
-            const double d2 = (points_[i] - q).squaredNorm();
-            if (d2 < best_d2) {
-                best_d2 = d2;
-                best = static_cast<long>(index_[i]);
-            }
-        }
-    }
-    return best;
+    Nearest nearest{max_d2};
+    if (!nodes_.empty()) Search(0, q, nearest);
+    return nearest.best;
 }
 
 std::vector<size_t> KdTree::KNearest(const Eigen::Vector3d& q, size_t k) const {
-    Best best{k, 1e300, {}};
+    KBest best{k, {}};
     best.items.reserve(k + 1);
     if (k > 0 && !nodes_.empty()) Search(0, q, best);
     std::sort_heap(best.items.begin(), best.items.end());

@@ -31,11 +31,11 @@ private:
         double split = 0.0;
         size_t left = 0, right = 0;
     };
-    // The best (squared distance, index) pairs found so far: a max-heap of at most k.
-    struct Best;
-
     size_t Build(std::vector<size_t>& order, size_t begin, size_t end,
                  const std::vector<Eigen::Vector3d>& points);
+    // Offers `best` every point of the leaves a point nearer than best.Bound() may be in, the
+    // nearer side of each split first (Best: Nearest or KBest, KdTree.cpp).
+    template <typename Best>
     void Search(size_t node, const Eigen::Vector3d& q, Best& best) const;
 
     std::vector<Eigen::Vector3d> points_;  // in leaf order
