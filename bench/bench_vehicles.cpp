@@ -60,9 +60,11 @@ bool Target(bool ok, const char* what) {
     return ok;
 }
 
-// Holds a row of the table to docs/vehicles.md (ParkingEval.hpp); prints each miss.
+// Holds a row of the table to docs/vehicles.md (ParkingEval.hpp), when it has one; prints each
+// miss.
 bool AsDocumented(double voxel, const char* name, const strata::testing::VehicleScore& s) {
-    const std::vector<std::string> off = strata::testing::OffTheDocumentedRow(voxel, name, s);
+    const std::vector<std::string> off =
+        strata::testing::OffTheDocumentedRow(voxel, name, s).value_or(std::vector<std::string>{});
     for (const std::string& what : off) {
         std::fprintf(stderr, "bench_vehicles: %.2f m, %s: %s off docs/vehicles.md\n", voxel, name,
                      what.c_str());

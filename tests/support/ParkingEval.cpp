@@ -152,11 +152,11 @@ constexpr DocumentedRow kDocumented[] = {
 
 }  // namespace
 
-std::vector<std::string> OffTheDocumentedRow(double voxel, const std::string& name,
-                                             const VehicleScore& s) {
-    std::vector<std::string> off;
+std::optional<std::vector<std::string>> OffTheDocumentedRow(double voxel, const std::string& name,
+                                                            const VehicleScore& s) {
     for (const DocumentedRow& d : kDocumented) {
         if (d.voxel != voxel || name != d.name) continue;
+        std::vector<std::string> off;
         const sim::SurfaceScore& f = s.surface;
         const auto check = [&](bool held, const char* what) {
             if (!held) off.emplace_back(what);
@@ -168,8 +168,9 @@ std::vector<std::string> OffTheDocumentedRow(double voxel, const std::string& na
         check(f.completeness_m <= kSlack * d.completeness_m, "completeness");
         check(f.chamfer_l1_m <= kSlack * d.chamfer_m, "Chamfer-L1");
         check(1.0 - f.fscore <= kSlack * (1.0 - d.fscore), "F-score");
+        return off;
     }
-    return off;
+    return std::nullopt;
 }
 
 }  // namespace strata::testing

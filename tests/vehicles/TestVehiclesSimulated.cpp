@@ -40,7 +40,9 @@ VehicleScore CleanAndScore(const core::VoxelMap& input, const VehicleConfig& con
     core::VoxelMap map = input.DeepCopy();
     const VehicleResult result = ClearVehicles(map, Parking().origins, config);
     const VehicleScore s = testing::ScoreVehicles(Parking(), map, result);
-    for (const std::string& what : testing::OffTheDocumentedRow(kVoxel, name, s)) {
+    const auto off = testing::OffTheDocumentedRow(kVoxel, name, s);
+    if (!off) ADD_FAILURE() << name << ": no such row in docs/vehicles.md's table";
+    for (const std::string& what : off.value_or(std::vector<std::string>{})) {
         ADD_FAILURE() << name << ": " << what << " off docs/vehicles.md";
     }
     std::printf("| %s | %zu / %zu | %zu | %.2f | %zu | %.4f | %.4f | %.4f | %.1f | %.1f | %.1f |\n",
