@@ -16,8 +16,10 @@
 #   STRATA_SANITIZE_MIN_TESTS=N  fail when fewer than N tests are selected (.ci/run sets it;
 #          default: $tsan_min_tests for tsan without arguments, else 1). With no test selected
 #          ctest itself fails (--no-tests=error).
-#   STRATA_ASAN_CI_SELECTION=1  asan: do not build the test files that hold only tests CI's ASan
-#          run leaves out (tests/AsanSlowTests.txt; .ci/run sets it)
+#   STRATA_ASAN_TEST_OBJECTS_FROM=DIR  asan: link the test programs from the objects of DIR, a
+#          build of this tree, instead of compiling the tests' own code with the sanitizers; the
+#          libraries, the program and the fuzz targets are instrumented as always (.ci/run sets
+#          it to build/: cmake/TestObjects.cmake)
 #   STRATA_SANITIZE_BUILD_ONLY=1  build (and for tsan, libtbb) and stop: .ci/run builds both
 #          in the background while the normal build's tests run, then runs the tests here.
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
@@ -105,13 +107,24 @@ common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++
         -DSTRATA_BUILD_PYTHON=OFF)
 if [[ $mode == asan ]]; then
   build="$root/build-fuzz"
-  # STRATA_ASAN_CI_SELECTION=1 (.ci/run): leave out the test files whose every test CI's ASan
-  # run leaves out (tests/AsanSlowTests.txt); unset, every test is built.
-  selection=OFF
-  [[ ${STRATA_ASAN_CI_SELECTION:-} == 1 ]] && selection=ON
+  # STRATA_ASAN_TEST_OBJECTS_FROM=DIR (.ci/run: build/): the test code comes from DIR's objects
+  # (cmake/TestObjects.cmake); unset, it is compiled here with the sanitizers.
+  objects_from=${STRATA_ASAN_TEST_OBJECTS_FROM:-}
+  [[ -n $objects_from ]] && objects_from=$(cd "$objects_from" && pwd)
   cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_BUILD_FUZZ=ON \
-    -DSTRATA_ASAN_CI_SELECTION=$selection >/dev/null
+    -DSTRATA_TEST_OBJECTS_FROM="$objects_from" >/dev/null
+  # With DIR the test code is left out of `all`: DIR's objects are brought up to date with the
+  # tree first, and `strata_test_code` links the test programs here. A build-only run (.ci/run's
+  # background build, which starts while DIR compiles) builds the rest and stops.
+  reuse=0
+  [[ -n $objects_from && ${STRATA_SANITIZE_BUILD_ONLY:-} != 1 ]] && reuse=1
+  if ((reuse)); then
+    cmake --build "$objects_from" -j "$jobs" --target ${STRATA_SANITIZE_TARGETS:-strata_test_code}
+  fi
   cmake --build "$build" -j "$jobs" ${STRATA_SANITIZE_TARGETS:+--target $STRATA_SANITIZE_TARGETS}
+  if ((reuse)) && [[ -z ${STRATA_SANITIZE_TARGETS:-} ]]; then
+    cmake --build "$build" -j "$jobs" --target strata_test_code
+  fi
   filter=()
   export STRATA_SANITIZER=address
 else
