@@ -62,6 +62,8 @@ function(_strata_test_sources out name)
                         "${name} (STRATA_BUILD_TESTS=OFF, or a dependency it needs not found)")
   endif()
   file(STRINGS ${list} objects)
+  # A reconfigured DIR may batch its sources anew: this build then configures again too.
+  set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${list})
   # They are made by the other build, maybe after this one is configured.
   set_source_files_properties(${objects} PROPERTIES EXTERNAL_OBJECT TRUE GENERATED TRUE)
   set(${out} ${objects} PARENT_SCOPE)
