@@ -62,7 +62,7 @@ function(_strata_test_sources out name)
                         "${name} (STRATA_BUILD_TESTS=OFF, or a dependency it needs not found)")
   endif()
   file(STRINGS ${list} objects)
-  # A reconfigured DIR may batch its sources anew: this build then configures again too.
+  # The other build, configured again, may batch its sources anew: then this one configures again.
   set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${list})
   # They are made by the other build, maybe after this one is configured.
   set_source_files_properties(${objects} PROPERTIES EXTERNAL_OBJECT TRUE GENERATED TRUE)
