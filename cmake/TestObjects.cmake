@@ -13,25 +13,65 @@
 # scoring run unchecked. g++'s and clang's objects link together: same standard library, same
 # ABI, no -march (the ASan build already links Debian's g++-built OpenVDB, Ceres and GTest).
 #
+# The same for the five OpenVDB grid types strata compiles (src/core/CMakeLists.txt,
+# `strata_grid_types`), with -DSTRATA_GRID_TYPES_FROM=<another build of this tree>: CI's ASan
+# build takes them from build/ (.ci/run compiles them there first). They are OpenVDB's trees
+# compiled whole, the most expensive files of every build (100 s of g++, about 200 s under ASan +
+# UBSan, 2026-12-07), and none of strata's own code: taken from build/ they run uninstrumented,
+# like the rest of libopenvdb. Not under TSan: the TBB hand-overs inlined in them (Tree::clear's
+# task group) would be invisible to it and reported as races (docs/reliability.md, "What the
+# builds cost alone, four levers left and one taken").
+#
 # In such a build the test-side targets are left out of `all` (their objects may not exist
 # yet when it starts: .ci/run builds the sanitizer libraries while build/ compiles); the target
 # `strata_test_code` builds them, in any build.
 set(STRATA_TEST_OBJECTS_FROM "" CACHE PATH
     "Link the test programs from the objects of this other build of the tree (CI's ASan build)")
 
-if(STRATA_TEST_OBJECTS_FROM)
-  if(NOT EXISTS ${STRATA_TEST_OBJECTS_FROM}/CMakeCache.txt)
-    message(FATAL_ERROR "STRATA_TEST_OBJECTS_FROM=${STRATA_TEST_OBJECTS_FROM} is not a configured "
+set(STRATA_GRID_TYPES_FROM "" CACHE PATH
+    "Link the grid types from the objects of this other build of the tree (CI's sanitizer builds)")
+
+# The other build must be a configured build of this very tree.
+foreach(_variable STRATA_TEST_OBJECTS_FROM STRATA_GRID_TYPES_FROM)
+  set(_dir ${${_variable}})
+  if(NOT _dir)
+    continue()
+  endif()
+  if(NOT EXISTS ${_dir}/CMakeCache.txt)
+    message(FATAL_ERROR "${_variable}=${_dir} is not a configured "
                         "build directory (configure it first: tools/configure.sh makes build/)")
   endif()
-  load_cache(${STRATA_TEST_OBJECTS_FROM} READ_WITH_PREFIX _from_ CMAKE_HOME_DIRECTORY)
+  load_cache(${_dir} READ_WITH_PREFIX _from_ CMAKE_HOME_DIRECTORY)
   file(REAL_PATH "${_from_CMAKE_HOME_DIRECTORY}" _from_source)
   file(REAL_PATH "${PROJECT_SOURCE_DIR}" _our_source)
   if(NOT _from_source STREQUAL _our_source)
-    message(FATAL_ERROR "STRATA_TEST_OBJECTS_FROM=${STRATA_TEST_OBJECTS_FROM} is a build of "
+    message(FATAL_ERROR "${_variable}=${_dir} is a build of "
                         "${_from_CMAKE_HOME_DIRECTORY}, not of this tree (${PROJECT_SOURCE_DIR})")
   endif()
-endif()
+endforeach()
+
+# strata_objects_from(<out> <name> <from> <sources...>): <sources> when <from> is empty (and the
+# list of <name>'s objects written for other builds), else <from>'s objects of <name>.
+function(strata_objects_from out name from)
+  if(NOT from)
+    # Written when the build is generated, after cmake/Unity.cmake has batched the sources.
+    file(GENERATE OUTPUT ${PROJECT_BINARY_DIR}/test-objects/${name}.txt
+         CONTENT "$<JOIN:$<TARGET_OBJECTS:${name}>,\n>\n")
+    set(${out} ${ARGN} PARENT_SCOPE)
+    return()
+  endif()
+  set(list ${from}/test-objects/${name}.txt)
+  if(NOT EXISTS ${list})
+    message(FATAL_ERROR "${list} is missing: ${from} was configured without "
+                        "${name} (STRATA_BUILD_TESTS=OFF, or a dependency it needs not found)")
+  endif()
+  file(STRINGS ${list} objects)
+  # The other build, configured again, may batch its sources anew: then this one configures again.
+  set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${list})
+  # They are made by the other build, maybe after this one is configured.
+  set_source_files_properties(${objects} PROPERTIES EXTERNAL_OBJECT TRUE GENERATED TRUE)
+  set(${out} ${objects} PARENT_SCOPE)
+endfunction()
 
 # strata_test_executable(<name> <sources...>), strata_test_library(<name> <sources...>): an
 # executable or static library of test code, compiled from <sources> or, with
@@ -49,24 +89,8 @@ function(strata_test_library name)
 endfunction()
 
 function(_strata_test_sources out name)
-  if(NOT STRATA_TEST_OBJECTS_FROM)
-    # Written when the build is generated, after cmake/Unity.cmake has batched the sources.
-    file(GENERATE OUTPUT ${PROJECT_BINARY_DIR}/test-objects/${name}.txt
-         CONTENT "$<JOIN:$<TARGET_OBJECTS:${name}>,\n>\n")
-    set(${out} ${ARGN} PARENT_SCOPE)
-    return()
-  endif()
-  set(list ${STRATA_TEST_OBJECTS_FROM}/test-objects/${name}.txt)
-  if(NOT EXISTS ${list})
-    message(FATAL_ERROR "${list} is missing: ${STRATA_TEST_OBJECTS_FROM} was configured without "
-                        "${name} (STRATA_BUILD_TESTS=OFF, or a dependency it needs not found)")
-  endif()
-  file(STRINGS ${list} objects)
-  # The other build, configured again, may batch its sources anew: then this one configures again.
-  set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${list})
-  # They are made by the other build, maybe after this one is configured.
-  set_source_files_properties(${objects} PROPERTIES EXTERNAL_OBJECT TRUE GENERATED TRUE)
-  set(${out} ${objects} PARENT_SCOPE)
+  strata_objects_from(sources ${name} "${STRATA_TEST_OBJECTS_FROM}" ${ARGN})
+  set(${out} ${sources} PARENT_SCOPE)
 endfunction()
 
 function(_strata_test_target name)

@@ -20,6 +20,11 @@
 #          build of this tree, instead of compiling the tests' own code with the sanitizers; the
 #          libraries, the program and the fuzz targets are instrumented as always (.ci/run sets
 #          it to build/: cmake/TestObjects.cmake)
+#   STRATA_ASAN_GRID_TYPES_FROM=DIR  asan: take the five OpenVDB grid types from DIR's objects
+#          (its `strata_grid_types`), uninstrumented, instead of compiling OpenVDB's trees again
+#          with the sanitizers (.ci/run sets it to build/ and compiles them there first:
+#          cmake/TestObjects.cmake). Not for tsan: TBB's hand-overs inlined in those objects would
+#          be invisible to it, and it reports them as races.
 #   STRATA_SANITIZE_BUILD_ONLY=1  build (and for tsan, libtbb) and stop: .ci/run builds both
 #          in the background while the normal build's tests run, then runs the tests here.
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
@@ -105,14 +110,26 @@ BuildTsanTbb() {
 common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++
         -DSTRATA_BUILD_TESTS=ON -DSTRATA_BUILD_TOOLS=ON -DSTRATA_BUILD_BENCH=OFF
         -DSTRATA_BUILD_PYTHON=OFF)
+
 if [[ $mode == asan ]]; then
   build="$root/build-fuzz"
   # STRATA_ASAN_TEST_OBJECTS_FROM=DIR (.ci/run: build/): the test code comes from DIR's objects
   # (cmake/TestObjects.cmake); unset, it is compiled here with the sanitizers.
   objects_from=${STRATA_ASAN_TEST_OBJECTS_FROM:-}
   [[ -n $objects_from ]] && objects_from=$(cd "$objects_from" && pwd)
+  # STRATA_ASAN_GRID_TYPES_FROM=DIR: DIR's grid types are brought up to date first, unless this
+  # is a build-only run (.ci/run's background build, which starts after it compiled them in
+  # build/ and while build/ compiles the rest: a second ninja in DIR then would race the first).
+  grid_types_from=${STRATA_ASAN_GRID_TYPES_FROM:-}
+  if [[ -n $grid_types_from ]]; then
+    grid_types_from=$(cd "$grid_types_from" && pwd)
+    if [[ ${STRATA_SANITIZE_BUILD_ONLY:-} != 1 ]]; then
+      cmake --build "$grid_types_from" -j "$jobs" --target strata_grid_types
+    fi
+  fi
   cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_BUILD_FUZZ=ON \
-    -DSTRATA_TEST_OBJECTS_FROM="$objects_from" >/dev/null
+    -DSTRATA_TEST_OBJECTS_FROM="$objects_from" -DSTRATA_GRID_TYPES_FROM="$grid_types_from" \
+    >/dev/null
   # With DIR the test code is left out of `all`: DIR's objects are brought up to date with the
   # tree first, and `strata_test_code` links the test programs here. A build-only run (.ci/run's
   # background build, which starts while DIR compiles) builds the rest and stops.
