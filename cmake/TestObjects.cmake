@@ -29,7 +29,7 @@ set(STRATA_TEST_OBJECTS_FROM "" CACHE PATH
     "Link the test programs from the objects of this other build of the tree (CI's ASan build)")
 
 set(STRATA_GRID_TYPES_FROM "" CACHE PATH
-    "Link the grid types from the objects of this other build of the tree (CI's sanitizer builds)")
+    "Link the grid types from the objects of this other build of the tree (CI's ASan build)")
 
 # The other build must be a configured build of this very tree.
 foreach(_variable STRATA_TEST_OBJECTS_FROM STRATA_GRID_TYPES_FROM)
@@ -62,8 +62,8 @@ function(strata_objects_from out name from)
   endif()
   set(list ${from}/test-objects/${name}.txt)
   if(NOT EXISTS ${list})
-    message(FATAL_ERROR "${list} is missing: ${from} was configured without "
-                        "${name} (STRATA_BUILD_TESTS=OFF, or a dependency it needs not found)")
+    message(FATAL_ERROR "${list} is missing: ${from} was configured without ${name} (for "
+                        "test code: STRATA_BUILD_TESTS=OFF, or a dependency it needs not found)")
   endif()
   file(STRINGS ${list} objects)
   # The other build, configured again, may batch its sources anew: then this one configures again.
