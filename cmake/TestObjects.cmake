@@ -13,7 +13,7 @@
 # scoring run unchecked. g++'s and clang's objects link together: same standard library, same
 # ABI, no -march (the ASan build already links Debian's g++-built OpenVDB, Ceres and GTest).
 #
-# The same for the five OpenVDB grid types strata compiles (src/core/CMakeLists.txt,
+# The same for the OpenVDB grid types strata compiles and their dilation (src/core/CMakeLists.txt,
 # `strata_grid_types`), with -DSTRATA_GRID_TYPES_FROM=<another build of this tree>: CI's ASan
 # build takes them from build/ (.ci/run compiles them there first). They are OpenVDB's trees
 # compiled whole, the most expensive files of every build (100 s of g++, about 200 s under ASan +

@@ -20,9 +20,9 @@
 #          build of this tree, instead of compiling the tests' own code with the sanitizers; the
 #          libraries, the program and the fuzz targets are instrumented as always (.ci/run sets
 #          it to build/: cmake/TestObjects.cmake)
-#   STRATA_ASAN_GRID_TYPES_FROM=DIR  asan: take the five OpenVDB grid types from DIR's objects
-#          (its `strata_grid_types`), uninstrumented, instead of compiling OpenVDB's trees again
-#          with the sanitizers (.ci/run sets it to build/ and compiles them there first:
+#   STRATA_ASAN_GRID_TYPES_FROM=DIR  asan: take the OpenVDB grid types and their dilation from
+#          DIR's objects (its `strata_grid_types`), uninstrumented, instead of compiling OpenVDB's
+#          trees again with the sanitizers (.ci/run sets it to build/ and compiles them there first:
 #          cmake/TestObjects.cmake). Not for tsan: TBB's hand-overs inlined in those objects would
 #          be invisible to it, and it reports them as races.
 #   STRATA_SANITIZE_BUILD_ONLY=1  build (and for tsan, libtbb) and stop: .ci/run builds both

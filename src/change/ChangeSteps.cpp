@@ -1,13 +1,13 @@
 // The steps of a change query (ChangeSteps.hpp), for the whole-map and the tile-by-tile query.
 #include "ChangeSteps.hpp"
 
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 
 #include <algorithm>
 #include <tuple>
 #include <vector>
 
+#include "strata/core/Dilate.hpp"
 #include "strata/core/Error.hpp"
 
 namespace strata::change::detail {
@@ -101,8 +101,7 @@ BoolGrid::Ptr Confident(const BoolGrid& candidates, const core::OccupancyMasks& 
 BoolGrid::Ptr GrowInto(const BoolGrid& confident, const BoolGrid& candidates, int steps) {
     BoolGrid::Ptr out = Copy(confident);
     if (steps <= 0 || out->empty()) return out;
-    openvdb::tools::dilateActiveValues(out->tree(), steps, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
+    core::DilateVoxels(out->tree(), steps, core::DilateTiles::kIgnore);
     out->topologyIntersection(candidates);
     return out;
 }

@@ -2,7 +2,6 @@
 
 #include <ceres/ceres.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +9,7 @@
 #include <stdexcept>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::geometry {
 namespace {
@@ -48,9 +48,9 @@ PlaneFit FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<
         cov.noalias() += weight(i) * q * q.transpose();
     }
     cov /= total;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    fit.eigenvalues = eig.eigenvalues().cwiseMax(0.0);
-    fit.axes = eig.eigenvectors();
+    const core::SymmetricEigen<3> eig = core::DecomposeSymmetric<3>(cov);
+    fit.eigenvalues = eig.values.cwiseMax(0.0);
+    fit.axes = eig.vectors;
     fit.plane.normal = fit.axes.col(0).normalized();
     fit.plane.d = -fit.plane.normal.dot(fit.centroid);
     fit.rms = std::sqrt(fit.eigenvalues[0]);
@@ -147,9 +147,9 @@ double XyEigenRatio(const std::vector<Eigen::Vector3d>& points) {
         const Eigen::Vector2d q = p.head<2>() - mean;
         cov.noalias() += q * q.transpose();
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-    const double small = std::max(0.0, eig.eigenvalues()[0]);
-    const double large = std::max(0.0, eig.eigenvalues()[1]);
+    const Eigen::Vector2d values = core::DecomposeSymmetric<2>(cov).values;
+    const double small = std::max(0.0, values[0]);
+    const double large = std::max(0.0, values[1]);
     if (large <= 0.0) return 1.0;
     return small > 0.0 ? large / small : std::numeric_limits<double>::infinity();
 }

@@ -8,7 +8,6 @@
 // the walls are the whole map's whatever the grouping.
 #include "WallsByTiles.hpp"
 
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 
 #include <algorithm>
@@ -24,6 +23,7 @@
 #include "TileBudget.hpp"
 #include "WallsGround.hpp"
 #include "WallsKept.hpp"
+#include "strata/core/Dilate.hpp"
 #include "strata/core/Endpoints.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/core/GridBox.hpp"
@@ -222,9 +222,7 @@ void CollectGroup(const store::TileReader& reader, const store::MapSettings& set
             CopyValue(labels, kept_labels, c);
         }
     }
-    openvdb::tools::dilateActiveValues(mine->tree(), walls::kObservedSideReachVoxels,
-                                       openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::EXPAND_TILES);
+    core::DilateVoxels(mine->tree(), walls::kObservedSideReachVoxels, core::DilateTiles::kExpand);
     const auto occupancy = g.occupancy->getConstAccessor();
     auto kept_free = kept.observed_free->getAccessor();
     for (auto it = mine->cbeginValueOn(); it; ++it) {

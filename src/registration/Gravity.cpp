@@ -3,13 +3,13 @@
 // returns lie on, refitted by PCA to the returns near it.
 #include "strata/registration/Gravity.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <random>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::registration {
 namespace {
@@ -35,12 +35,12 @@ Plane FitPlane(const std::vector<Eigen::Vector3d>& points, double* rms) {
     mean /= static_cast<double>(points.size());
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     for (const Eigen::Vector3d& p : points) covariance += (p - mean) * (p - mean).transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+    const core::SymmetricEigen<3> eigen = core::DecomposeSymmetric<3>(covariance);
     Plane plane;
-    plane.n = eigen.eigenvectors().col(0);
+    plane.n = eigen.vectors.col(0);
     if (plane.n.z() < 0.0) plane.n = -plane.n;
     plane.d = -plane.n.dot(mean);
-    *rms = std::sqrt(std::max(eigen.eigenvalues()(0), 0.0) / static_cast<double>(points.size()));
+    *rms = std::sqrt(std::max(eigen.values(0), 0.0) / static_cast<double>(points.size()));
     return plane;
 }
 

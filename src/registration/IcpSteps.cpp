@@ -3,10 +3,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "CostFunctions.hpp"
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::registration::detail {
 
@@ -133,10 +133,10 @@ Eigen::Matrix<double, 6, 1> NormalEigenvalues(const std::vector<Match>& matches,
     if (planar) {
         const Eigen::Matrix3d block = H.block<3, 3>(2, 2);
         Eigen::Matrix<double, 6, 1> ev = Eigen::Matrix<double, 6, 1>::Zero();
-        ev.head<3>() = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvalues();
+        ev.head<3>() = core::DecomposeSymmetric<3>(block).values;
         return ev;
     }
-    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H).eigenvalues();
+    return core::DecomposeSymmetric<6>(H).values;
 }
 
 double PlaneRmse(const std::vector<Match>& matches) {

@@ -1,8 +1,9 @@
 #include "LocalMap.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
+
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::registration::detail {
 namespace {
@@ -41,14 +42,14 @@ void LocalMap::FitShape(const Key& key, Cell& cell) const {
     if (n < kMinShapePoints) return;
     const Eigen::Vector3d mean = sum / static_cast<double>(n);
     const Eigen::Matrix3d covariance = outer / static_cast<double>(n) - mean * mean.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-    const Eigen::Vector3d values = eigen.eigenvalues();  // ascending
+    const core::SymmetricEigen<3> eigen = core::DecomposeSymmetric<3>(covariance);
+    const Eigen::Vector3d& values = eigen.values;  // ascending
     if (values(1) <= max_planarity_ratio_ * values(2)) {
         cell.shape = Shape::kLine;
-        cell.axis = eigen.eigenvectors().col(2);
+        cell.axis = eigen.vectors.col(2);
     } else if (values(0) <= max_planarity_ratio_ * values(1)) {
         cell.shape = Shape::kPlane;
-        cell.axis = eigen.eigenvectors().col(0);
+        cell.axis = eigen.vectors.col(0);
     }
 }
 

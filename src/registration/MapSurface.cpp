@@ -1,6 +1,5 @@
 #include "strata/registration/MapSurface.hpp"
 
-#include <openvdb/tools/Morphology.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -9,6 +8,7 @@
 #include <chrono>
 
 #include "SurfaceSums.hpp"
+#include "strata/core/Dilate.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/store/TileReader.hpp"
 
@@ -20,8 +20,7 @@ namespace {
 // OpenVDB's compiled threading, tools/tsan-suppressions.txt).
 CellMask::Ptr Grown(const CellMask& grid, int cells) {
     CellMask::Ptr out = grid.deepCopy();
-    openvdb::tools::dilateActiveValues(out->tree(), cells, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES, /*threaded=*/false);
+    core::DilateVoxels(out->tree(), cells, core::DilateTiles::kIgnore, /*threaded=*/false);
     return out;
 }
 

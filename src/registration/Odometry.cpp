@@ -10,7 +10,6 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +19,7 @@
 
 #include "LocalMap.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/SymmetricEigen.hpp"
 #include "strata/registration/Surface.hpp"
 
 namespace strata::registration {
@@ -93,12 +93,12 @@ double SolveConstrained(const Equations& e, double arm_m, double min_eigenvalue,
     scale << 1, 1, 1, 1.0 / arm_m, 1.0 / arm_m, 1.0 / arm_m;
     const Matrix6d H = scale.asDiagonal() * e.H * scale.asDiagonal() / e.weight;
     const Vector6d g = scale.asDiagonal() * e.g / e.weight;
-    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(H);
+    const core::SymmetricEigen<6> eigen = core::DecomposeSymmetric<6>(H);
     Vector6d step = Vector6d::Zero();
     weak->clear();
     for (int i = 0; i < 6; ++i) {
-        const double lambda = eigen.eigenvalues()(i);
-        const Vector6d v = eigen.eigenvectors().col(i);
+        const double lambda = eigen.values(i);
+        const Vector6d v = eigen.vectors.col(i);
         if (lambda < min_eigenvalue) {
             weak->push_back(v);
             continue;
@@ -106,7 +106,7 @@ double SolveConstrained(const Equations& e, double arm_m, double min_eigenvalue,
         step -= (v.dot(g) / lambda) * v;
     }
     *dx = scale.asDiagonal() * step;
-    return eigen.eigenvalues()(0);
+    return eigen.values(0);
 }
 
 // In words, a motion the matches left to the prediction: `weakest` (world frame) seen from the

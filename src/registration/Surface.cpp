@@ -5,7 +5,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +12,7 @@
 
 #include "SurfaceSums.hpp"
 #include "strata/core/Error.hpp"
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::registration {
 
@@ -37,10 +37,10 @@ struct Moments {
 bool FitNormal(const Moments& m, const SurfaceConfig& config, Eigen::Vector3d& normal) {
     const Eigen::Vector3d mean = m.sum / m.n;
     const Eigen::Matrix3d cov = m.outer / m.n - mean * mean.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
+    const core::SymmetricEigen<3> eig = core::DecomposeSymmetric<3>(cov);
+    const Eigen::Vector3d& ev = eig.values;  // ascending
     if (!(ev(1) > 0.0) || ev(0) > config.max_planarity_ratio * ev(1)) return false;
-    normal = eig.eigenvectors().col(0).normalized();
+    normal = eig.vectors.col(0).normalized();
     return true;
 }
 

@@ -1,11 +1,11 @@
 #include "strata/registration/TrajectoryError.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 
 #include "strata/core/Error.hpp"
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::registration {
 namespace {
@@ -31,8 +31,7 @@ Eigen::Isometry3d RigidFit(const Eigen::Matrix3Xd& ours, const Eigen::Matrix3Xd&
         S(1, 2) - S(2, 1), S(0, 0) - S(1, 1) - S(2, 2), S(0, 1) + S(1, 0), S(2, 0) + S(0, 2),
         S(2, 0) - S(0, 2), S(0, 1) + S(1, 0), -S(0, 0) + S(1, 1) - S(2, 2), S(1, 2) + S(2, 1),
         S(0, 1) - S(1, 0), S(2, 0) + S(0, 2), S(1, 2) + S(2, 1), -S(0, 0) - S(1, 1) + S(2, 2);
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(N);
-    const Eigen::Vector4d q = eigen.eigenvectors().col(3);  // eigenvalues ascend
+    const Eigen::Vector4d q = core::DecomposeSymmetric<4>(N).vectors.col(3);  // values ascend
     Eigen::Isometry3d fit = Eigen::Isometry3d::Identity();
     fit.linear() = Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized().toRotationMatrix();
     fit.translation() = mean_theirs - fit.linear() * mean_ours;

@@ -4,12 +4,12 @@
 // it unposed for the odometry, and `strata odometry --bag` / `strata integrate --bag --odometry`
 // pose and deskew it themselves (docs/odometry.md).
 #include <gtest/gtest.h>
-#include <openvdb/tools/Morphology.h>
 
 #include "BagFixtures.hpp"
 #include "CliTestUtil.hpp"
 #include "MovingStreet.hpp"
 #include "Sanitizer.hpp"
+#include "strata/core/Dilate.hpp"
 #include "strata/core/Error.hpp"
 #include "strata/integration/Integrator.hpp"
 #include "strata/io/PoseFiles.hpp"
@@ -209,7 +209,7 @@ double StrayShare(const core::VoxelMap& map, const MovingSweeps& drive,
             acc.setValueOn(truth.transform().worldToIndexCellCentered({q.x(), q.y(), q.z()}));
         }
     }
-    openvdb::tools::dilateActiveValues(truth.tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX);
+    core::DilateVoxels(truth.tree(), 1, core::DilateTiles::kPreserve);
     size_t occupied = 0, stray = 0;
     for (auto it = map.occupancy->cbeginValueOn(); it; ++it) {
         if (*it <= 0.0f) continue;

@@ -4,9 +4,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+
+#include "strata/core/SymmetricEigen.hpp"
 
 namespace strata::registration::test {
 
@@ -50,9 +51,9 @@ RawPointToPlane::RawPointToPlane(std::vector<Eigen::Vector3d> target, const RawI
             mean /= double(near.size());
             Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
             for (size_t j : near) cov += (target[j] - mean) * (target[j] - mean).transpose();
-            const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-            normals[i] = eig.eigenvectors().col(0);
-            const Eigen::Vector3d ev = eig.eigenvalues();
+            const core::SymmetricEigen<3> eig = core::DecomposeSymmetric<3>(cov);
+            normals[i] = eig.vectors.col(0);
+            const Eigen::Vector3d& ev = eig.values;
             planar[i] = ev(0) <= config_.max_planarity_ratio * ev(1) ? 1 : 0;
         }
     });

@@ -13,6 +13,15 @@
 
 #include <cstdint>
 
+namespace strata::core {
+
+/// @brief A bool tree of small nodes (8^3 voxels a leaf, 64^3 and 512^3 above) for a set of cells
+/// spread thinly over a wide area, where the default's 128^3-voxel nodes cost 32 KB for every one
+/// touched (registration::CellMask).
+using SparseBoolTree = openvdb::tree::Tree4<bool, 3, 3, 3>::Type;
+
+}  // namespace strata::core
+
 namespace openvdb {
 OPENVDB_USE_VERSION_NAMESPACE
 namespace OPENVDB_VERSION_NAME {
@@ -27,6 +36,8 @@ extern template class tree::Tree<MaskTree::RootNodeType>;
 extern template class Grid<MaskTree>;
 extern template class tree::Tree<Vec3STree::RootNodeType>;
 extern template class Grid<Vec3STree>;
+extern template class tree::Tree<strata::core::SparseBoolTree::RootNodeType>;
+extern template class Grid<strata::core::SparseBoolTree>;
 
 }  // namespace OPENVDB_VERSION_NAME
 }  // namespace openvdb

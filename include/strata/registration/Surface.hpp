@@ -37,9 +37,9 @@ private:
 };
 
 /// @brief A set of cells spread thinly over a wide area (the cells around a source's sampled
-/// points): a VDB tree of small nodes (8^3 cells a leaf, 64^3 and 512^3 above), where the
-/// default's 128^3-cell nodes cost 32 KB for every 32 m touched (at 0.25 m cells).
-using CellMask = openvdb::Grid<openvdb::tree::Tree4<bool, 3, 3, 3>::Type>;
+/// points): a VDB tree of small nodes (core::SparseBoolTree), where the default's 128^3-cell
+/// nodes cost 32 KB for every 32 m touched (at 0.25 m cells).
+using CellMask = openvdb::Grid<core::SparseBoolTree>;
 
 /// @brief One level of a matching surface: one point per cell of `cell_m` (the mean of the input
 /// points in it) with the unit normal of its neighbourhood. Only planar cells are kept.
