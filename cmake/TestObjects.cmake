@@ -13,12 +13,13 @@
 # scoring run unchecked. g++'s and clang's objects link together: same standard library, same
 # ABI, no -march (the ASan build already links Debian's g++-built OpenVDB, Ceres and GTest).
 #
-# The same for the OpenVDB grid types strata compiles and their dilation (src/core/CMakeLists.txt,
-# `strata_grid_types`), with -DSTRATA_GRID_TYPES_FROM=<another build of this tree>: CI's ASan
-# build takes them from build/ (.ci/run compiles them there first). They are OpenVDB's trees
-# compiled whole, the most expensive files of every build (100 s of g++, about 200 s under ASan +
-# UBSan, 2026-12-07), and none of strata's own code: taken from build/ they run uninstrumented,
-# like the rest of libopenvdb. Not under TSan: the TBB hand-overs inlined in them (Tree::clear's
+# The same for the third-party templates strata compiles once (src/core/CMakeLists.txt,
+# `strata_templates`: OpenVDB's grid types and their dilation, Eigen's symmetric eigen-solver),
+# with -DSTRATA_TEMPLATES_FROM=<another build of this tree>: CI's ASan build takes them from
+# build/ (.ci/run compiles them there first). OpenVDB's trees compiled whole are the most
+# expensive files of every build (100 s of g++, about 200 s under ASan + UBSan, 2026-12-07), and
+# none of it is strata's own code: taken from build/ they run uninstrumented, like the rest of
+# libopenvdb and Debian's g++-built Ceres, whose solvers call the same Eigen code. Not under TSan: the TBB hand-overs inlined in them (Tree::clear's
 # task group) would be invisible to it and reported as races (docs/reliability.md, "What the
 # builds cost alone, four levers left and one taken").
 #
@@ -28,11 +29,11 @@
 set(STRATA_TEST_OBJECTS_FROM "" CACHE PATH
     "Link the test programs from the objects of this other build of the tree (CI's ASan build)")
 
-set(STRATA_GRID_TYPES_FROM "" CACHE PATH
-    "Link the grid types from the objects of this other build of the tree (CI's ASan build)")
+set(STRATA_TEMPLATES_FROM "" CACHE PATH
+    "Link the compiled templates from this other build's objects (CI's ASan build)")
 
 # The other build must be a configured build of this very tree.
-foreach(_variable STRATA_TEST_OBJECTS_FROM STRATA_GRID_TYPES_FROM)
+foreach(_variable STRATA_TEST_OBJECTS_FROM STRATA_TEMPLATES_FROM)
   set(_dir ${${_variable}})
   if(NOT _dir)
     continue()

@@ -20,11 +20,12 @@
 #          build of this tree, instead of compiling the tests' own code with the sanitizers; the
 #          libraries, the program and the fuzz targets are instrumented as always (.ci/run sets
 #          it to build/: cmake/TestObjects.cmake)
-#   STRATA_ASAN_GRID_TYPES_FROM=DIR  asan: take the OpenVDB grid types and their dilation from
-#          DIR's objects (its `strata_grid_types`), uninstrumented, instead of compiling OpenVDB's
-#          trees again with the sanitizers (.ci/run sets it to build/ and compiles them there first:
-#          cmake/TestObjects.cmake). Not for tsan: TBB's hand-overs inlined in those objects would
-#          be invisible to it, and it reports them as races.
+#   STRATA_ASAN_TEMPLATES_FROM=DIR  asan: take the compiled third-party templates (OpenVDB's grid
+#          types and dilation, Eigen's eigen-solver) from DIR's objects (its `strata_templates`),
+#          uninstrumented, instead of compiling them again with the sanitizers (.ci/run sets
+#          it to build/ and compiles them there first: cmake/TestObjects.cmake). Not for tsan:
+#          TBB's hand-overs inlined in those objects would be invisible to it, and it reports
+#          them as races.
 #   STRATA_SANITIZE_BUILD_ONLY=1  build (and for tsan, libtbb) and stop: .ci/run builds both
 #          in the background while the normal build's tests run, then runs the tests here.
 # Sanitizer reports land in build-*/sanitizer-reports/ (one file per process, printed on failure).
@@ -117,18 +118,18 @@ if [[ $mode == asan ]]; then
   # (cmake/TestObjects.cmake); unset, it is compiled here with the sanitizers.
   objects_from=${STRATA_ASAN_TEST_OBJECTS_FROM:-}
   [[ -n $objects_from ]] && objects_from=$(cd "$objects_from" && pwd)
-  # STRATA_ASAN_GRID_TYPES_FROM=DIR: DIR's grid types are brought up to date first, unless this
-  # is a build-only run (.ci/run's background build, which starts after it compiled them in
+  # STRATA_ASAN_TEMPLATES_FROM=DIR: DIR's compiled templates are brought up to date first, unless
+  # this is a build-only run (.ci/run's background build, which starts after it compiled them in
   # build/ and while build/ compiles the rest: a second ninja in DIR then would race the first).
-  grid_types_from=${STRATA_ASAN_GRID_TYPES_FROM:-}
-  if [[ -n $grid_types_from ]]; then
-    grid_types_from=$(cd "$grid_types_from" && pwd)
+  templates_from=${STRATA_ASAN_TEMPLATES_FROM:-}
+  if [[ -n $templates_from ]]; then
+    templates_from=$(cd "$templates_from" && pwd)
     if [[ ${STRATA_SANITIZE_BUILD_ONLY:-} != 1 ]]; then
-      cmake --build "$grid_types_from" -j "$jobs" --target strata_grid_types
+      cmake --build "$templates_from" -j "$jobs" --target strata_templates
     fi
   fi
   cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_BUILD_FUZZ=ON \
-    -DSTRATA_TEST_OBJECTS_FROM="$objects_from" -DSTRATA_GRID_TYPES_FROM="$grid_types_from" \
+    -DSTRATA_TEST_OBJECTS_FROM="$objects_from" -DSTRATA_TEMPLATES_FROM="$templates_from" \
     >/dev/null
   # With DIR the test code is left out of `all`: DIR's objects are brought up to date with the
   # tree first, and `strata_test_code` links the test programs here. A build-only run (.ci/run's
@@ -186,6 +187,11 @@ if ((selected < min_tests)); then
   echo "sanitize.sh: only $selected tests selected, expected at least $min_tests" >&2
   exit 1
 fi
+# The fixtures the test processes share, each made once in this run by the first test that wants
+# it (tests/support/SharedFixture.hpp), in a folder of this run's own.
+STRATA_TEST_FIXTURES=$(mktemp -d "${TMPDIR:-/tmp}/strata_fixtures_XXXXXX")
+export STRATA_TEST_FIXTURES
+trap 'rm -rf "$STRATA_TEST_FIXTURES"' EXIT
 test_start=$(date +%s)
 status=0
 ctest --test-dir "$build" --output-on-failure --no-tests=error \

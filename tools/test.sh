@@ -33,6 +33,11 @@ if ((${count:-0} < min_tests)); then
   short=1
 fi
 ((short == 0)) || exit 1
+# The fixtures the test processes share, each made once in this run by the first test that wants
+# it (tests/support/SharedFixture.hpp), in a folder of this run's own.
+STRATA_TEST_FIXTURES=$(mktemp -d "${TMPDIR:-/tmp}/strata_fixtures_XXXXXX")
+export STRATA_TEST_FIXTURES
+trap 'rm -rf "$STRATA_TEST_FIXTURES"' EXIT
 # CTest counts a skipped test as passed: with STRATA_REQUIRE_DATA=1 (.ci/run) a skip fails the
 # run (the real-data tests also fail by themselves then, tests/support/RealData.hpp).
 log="$root/build/ctest-last.log"

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "Sanitizer.hpp"
+#include "SharedFixture.hpp"
 #include "SyntheticRoom.hpp"
 #include "TempPath.hpp"
 #include "strata/pipeline/Integrate.hpp"
@@ -131,18 +132,18 @@ inline const SimulatedScene& BuildingMap(const fs::path& dir, int scans) {
 /// (docs/reliability.md, "Sanitizers").
 inline double SmallTileM() { return strata::testing::UnderSanitizer() ? 9.6 : 6.4; }
 
-/// datasets/scenes/street.json, 12 scans, integrated in SmallTileM() tiles, once per process:
-/// the map the tile-by-tile analyses are compared with their whole-map selves on (read only).
+/// datasets/scenes/street.json, 12 scans, integrated in SmallTileM() tiles, once per suite run
+/// (strata::test::SharedFixture): the map the tile-by-tile analyses are compared with their
+/// whole-map selves on (read only).
 inline const fs::path& StreetInSmallTiles() {
-    static const fs::path dir = [] {
-        const fs::path d = Temp("street_small_tiles");
-        ScanSpec scans;
-        scans.kitti = Simulated("street", 12).report.sessions.at(0).dir;
-        IntegrateOptions options;
-        options.map.tile_size_m = SmallTileM();
-        (void)IntegrateSession(d, scans, options);
-        return d;
-    }();
+    static const fs::path dir = strata::test::SharedFixture(
+        "street_12_scans_in_tiles_of_" + std::to_string(SmallTileM()), [](const fs::path& d) {
+            ScanSpec scans;
+            scans.kitti = Simulated("street", 12).report.sessions.at(0).dir;
+            IntegrateOptions options;
+            options.map.tile_size_m = SmallTileM();
+            (void)IntegrateSession(d, scans, options);
+        });
     return dir;
 }
 

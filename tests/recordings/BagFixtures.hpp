@@ -34,14 +34,20 @@ inline std::string Run(const std::string& command) {
     return output;
 }
 
-/// The scans of `seq` (a KITTI-layout folder) as a ROS 1 bag at a fresh temporary path, written
-/// by python3-rosbag with write_ros1_bag.py's `options`.
-inline fs::path WriteRos1Bag(const fs::path& seq, const std::string& name,
-                             const std::string& options = "") {
-    const fs::path out = strata::test::TempPath(name + ".bag");
+/// The scans of `seq` (a KITTI-layout folder) as a ROS 1 bag at `out`, written by python3-rosbag
+/// with write_ros1_bag.py's `options`.
+inline void WriteRos1BagTo(const fs::path& seq, const fs::path& out,
+                           const std::string& options = "") {
     Run(std::string(STRATA_PYTHON3) + " " +
         (fs::path(STRATA_SOURCE_DIR) / "tests/recordings/write_ros1_bag.py").string() + " " +
         seq.string() + " " + out.string() + " " + options);
+}
+
+/// The same at a fresh temporary path.
+inline fs::path WriteRos1Bag(const fs::path& seq, const std::string& name,
+                             const std::string& options = "") {
+    const fs::path out = strata::test::TempPath(name + ".bag");
+    WriteRos1BagTo(seq, out, options);
     return out;
 }
 

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "CliTestUtil.hpp"
 #include "Format4Map.hpp"
+#include "SharedFixture.hpp"
 #include "strata/io/Image.hpp"
 #include "strata/store/MapStore.hpp"
 
@@ -16,15 +18,16 @@ namespace {
 
 using nlohmann::json;
 
+// The street's first 6 scans, simulated once per suite run (strata::test::SharedFixture).
 const fs::path& StreetSequence() {
-    static const fs::path seq = [] {
-        const fs::path dir = Temp("dynamic_seq");
-        const std::string scene = std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
-        const Result sim = Strata("simulate --scene " + scene + " --out " + dir.string() +
-                                  " --max-scans 6 --no-picture");
-        EXPECT_EQ(sim.code, 0) << sim.out;
-        return dir;
-    }();
+    static const fs::path seq =
+        strata::test::SharedFixture("dynamic_cli_street_6_scans", [](const fs::path& dir) {
+            const std::string scene =
+                std::string(STRATA_SOURCE_DIR) + "/datasets/scenes/street.json";
+            const Result sim = Strata("simulate --scene " + scene + " --out " + dir.string() +
+                                      " --max-scans 6 --no-picture");
+            if (sim.code != 0) throw std::runtime_error("strata simulate failed: " + sim.out);
+        });
     return seq;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Growing a set of voxels, compiled once (src/core/grid_types/Dilate.cpp): OpenVDB's morphology
+// Growing a set of voxels, compiled once (src/core/templates/Dilate.cpp): OpenVDB's morphology
 // costs about 25 s of g++ (35 s of clang with the sanitizers) in every file that instantiates it.
 
 #include "strata/core/GridTypes.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// The OpenVDB grid types of strata, compiled once (src/core/grid_types/). Include this header,
+// The OpenVDB grid types of strata, compiled once (src/core/templates/). Include this header,
 // not <openvdb/openvdb.h>, wherever grids are made, copied, read or written.
 //
 // Why: OpenVDB 10 compiles its tools into libopenvdb but leaves Grid<T> and Tree<T> to every file

@@ -1,7 +1,7 @@
 #pragma once
 // The eigen-decomposition of a small symmetric matrix, compiled once for the sizes strata uses
-// (src/core/SymmetricEigen.cpp): Eigen's SelfAdjointEigenSolver costs about 9 s of g++ (20 s of
-// clang with the sanitizers) for each size in every file that instantiates it.
+// (src/core/templates/SymmetricEigen.cpp): Eigen's SelfAdjointEigenSolver costs about 9 s of g++
+// (20 s of clang with the sanitizers) for each size in every file that instantiates it.
 
 #include <Eigen/Core>
 
