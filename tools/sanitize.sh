@@ -152,11 +152,13 @@ else
   export LD_LIBRARY_PATH="$tbb_lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
   cmake -S "$root" -B "$build" "${common[@]}" -DSTRATA_SANITIZE=thread >/dev/null
   cmake --build "$build" -j "$jobs" --target ${STRATA_SANITIZE_TARGETS:-${tsan_targets[*]}}
-  # ldd's whole output first: `ldd | grep -q` under pipefail fails at random when grep exits on
-  # its match before ldd has written its last line (SIGPIPE), as one CI run did.
-  loads=$(ldd "$build/tests/integration/test_integration")
+  # The libraries every test program links resolve libtbb to the TSan build's (checked on one of
+  # them: STRATA_SANITIZE_TARGETS may leave any program out). ldd's whole output first: `ldd |
+  # grep -q` under pipefail fails at random when grep exits on its match before ldd has written
+  # its last line (SIGPIPE), as one CI run did.
+  loads=$(ldd "$build/src/core/libstrata_core.so")
   if [[ $loads != *"$tbb_lib/libtbb.so.12 "* ]]; then
-    echo "sanitize.sh: the tests do not load the TSan libtbb in $tbb_lib:" >&2
+    echo "sanitize.sh: strata's libraries do not load the TSan libtbb in $tbb_lib:" >&2
     echo "$loads" >&2
     exit 1
   fi

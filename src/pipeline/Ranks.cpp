@@ -1,9 +1,11 @@
 #include "strata/pipeline/Ranks.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cstdlib>
 #include <numeric>
+#include <thread>
 
 #include "strata/core/Error.hpp"
 
@@ -26,9 +28,34 @@ int LaunchedRanks() {
 
 #ifdef STRATA_WITH_MPI
 
+namespace {
+
+// Returns once every rank has called it, sleeping between looks instead of polling. Open MPI's
+// blocking calls wait in a busy loop: a rank waiting for rank 0 (its commit, the odometry's
+// poses, the last rank's share) would hold a core the working ranks need, on a machine with
+// fewer cores than ranks, and burn it on any. Each exchange below starts here, so its own
+// blocking call finds every rank present and spins only while the bytes move. The pause grows
+// to 1 ms: at most that late, about a thousand cheap looks a second while a rank waits.
+void AwaitEveryRank() {
+    MPI_Request request = MPI_REQUEST_NULL;
+    MPI_Ibarrier(MPI_COMM_WORLD, &request);
+    auto pause = std::chrono::microseconds(20);
+    for (int done = 0;;) {
+        MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+        if (done != 0) return;
+        std::this_thread::sleep_for(pause);
+        pause = std::min(2 * pause, std::chrono::microseconds(1000));
+    }
+}
+
+}  // namespace
+
 struct Ranks::Mpi {
     Mpi(int* argc, char*** argv) { MPI_Init(argc, argv); }
-    ~Mpi() { MPI_Finalize(); }
+    ~Mpi() {
+        AwaitEveryRank();  // MPI_Finalize waits for the others in a busy loop too
+        MPI_Finalize();
+    }
     Mpi(const Mpi&) = delete;
     Mpi& operator=(const Mpi&) = delete;
 };
@@ -80,6 +107,7 @@ std::vector<std::string> Ranks::Exchange(const std::vector<std::string>& out) co
         send_counts[r] = MessageBytes(out[r].size());
         send += out[r];
     }
+    AwaitEveryRank();
     MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
     const size_t total = std::accumulate(recv_counts.begin(), recv_counts.end(), size_t{0});
     std::string recv(total, '\0');
@@ -96,6 +124,7 @@ std::vector<std::string> Ranks::Gather(const std::string& bytes) const {
     if (!mpi_) return {bytes};
     int count = MessageBytes(bytes.size());
     std::vector<int> counts(root() ? static_cast<size_t>(size_) : 0);
+    AwaitEveryRank();
     MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
     const std::vector<int> offsets = Displacements(counts);
     std::string all(root() ? std::accumulate(counts.begin(), counts.end(), size_t{0}) : 0, '\0');
@@ -107,6 +136,7 @@ std::vector<std::string> Ranks::Gather(const std::string& bytes) const {
 std::string Ranks::Broadcast(const std::string& bytes) const {
     if (!mpi_) return bytes;
     int count = root() ? MessageBytes(bytes.size()) : 0;
+    AwaitEveryRank();
     MPI_Bcast(&count, 1, MPI_INT, 0, MPI_COMM_WORLD);
     std::string out = root() ? bytes : std::string(static_cast<size_t>(count), '\0');
     MPI_Bcast(out.data(), count, MPI_CHAR, 0, MPI_COMM_WORLD);
@@ -116,6 +146,7 @@ std::string Ranks::Broadcast(const std::string& bytes) const {
 bool Ranks::AllOk(bool ok) const {
     if (!mpi_) return ok;
     int mine = ok ? 1 : 0, all = 0;
+    AwaitEveryRank();
     MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     return all == 1;
 }
