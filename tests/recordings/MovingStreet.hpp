@@ -29,11 +29,15 @@ struct MovingSweeps {
     std::vector<std::vector<Eigen::Vector3d>> origin;  // per sweep, each point's ray origin
 };
 
+/// write_ros1_bag.py's `options` with `--motion` from the end poses of the sweeps in `dir`.
+inline std::string MotionOptions(const fs::path& dir, const std::string& options) {
+    return options + " --motion " + (dir / "end_poses.txt").string();
+}
+
 /// Another bag of `sweeps`' folder, written with `options` besides `--motion`.
 inline fs::path WriteMovingBag(const MovingSweeps& sweeps, const std::string& name,
                                const std::string& options) {
-    return WriteRos1Bag(sweeps.dir, name,
-                        options + " --motion " + (sweeps.dir / "end_poses.txt").string());
+    return WriteRos1Bag(sweeps.dir, name, MotionOptions(sweeps.dir, options));
 }
 
 /// The first `max_scans` sweeps of datasets/scenes/street.json's drive at 10 m/s, a sweep every
@@ -116,13 +120,12 @@ inline MovingSweeps WriteMovingStreet(const std::string& sensor, int max_scans, 
         out.truth.push_back(std::move(world));
         out.origin.push_back(std::move(origin));
     }
-    out.bag = strata::test::SharedFixture(
-                  key + "_bag",
-                  [&](const fs::path& dir) {
-                      fs::create_directories(dir);
-                      WriteRos1BagTo(out.dir, dir / (name + ".bag"),
-                                     options + " --motion " + (out.dir / "end_poses.txt").string());
-                  }) /
+    out.bag = strata::test::SharedFixture(key + "_bag",
+                                          [&](const fs::path& dir) {
+                                              fs::create_directories(dir);
+                                              WriteRos1BagTo(out.dir, dir / (name + ".bag"),
+                                                             MotionOptions(out.dir, options));
+                                          }) /
               (name + ".bag");
     return out;
 }
