@@ -1,14 +1,9 @@
 // Scan-to-map odometry (docs/odometry.md, "Method"): a constant-velocity prediction (its rotation
-// from the gyro when there is one), then
-// Gauss-Newton on the distance of each point to the map's plane, line or point around its nearest
-// map point, under a Geman-McClure kernel, with the correspondence distance adapted to how far
-// scans deviate from the prediction; the registered scan then joins a local map that forgets what
-// lies beyond the sensor's range.
+// from the gyro when there is one), then Gauss-Newton on the distance of each point to the map's
+// plane or upright line around its nearest map point (the steps in ScanToMap.cpp), with the
+// correspondence distance adapted to how far scans deviate from the prediction; the registered
+// scan then joins a local map that forgets what lies beyond the sensor's range.
 #include "strata/registration/Odometry.hpp"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,203 +13,18 @@
 #include <vector>
 
 #include "LocalMap.hpp"
+#include "ScanToMap.hpp"
 #include "strata/core/Error.hpp"
-#include "strata/core/SymmetricEigen.hpp"
 #include "strata/registration/Surface.hpp"
 
 namespace strata::registration {
 namespace {
 
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-
 constexpr double kMapThinning = 0.5;     // a scan joins the map at one point per half cell
 constexpr double kSourceThinning = 1.5;  // and is registered at one per 1.5 cells
-constexpr size_t kPointGrain = 256;      // fixed, so the sums do not depend on thread count
 // Directions whose eigenvalue per unit of match weight is below this are left to the prediction:
 // a plane matched from every point constrains its normal direction with 1.
 constexpr double kMinEigenvalue = 0.002;
-// A line of map points within 45 degrees of the vertical is a pole, a trunk or an upright edge;
-// a flatter one is mostly one ring of the sensor's returns on the ground, which moves with the
-// sensor and would hold it back, and is not matched. (The world's z is up: the first scan
-// levelled by its ground, or where the caller put it.)
-const double kMinLineZ = std::sqrt(0.5);
-
-// The normal equations of one Gauss-Newton step, summed over the matched points.
-struct Equations {
-    Matrix6d H = Matrix6d::Zero();
-    Vector6d g = Vector6d::Zero();
-    size_t matched = 0;
-    double squared = 0.0;  // sum of squared residual norms
-    double weight = 0.0;   // sum of the kernel's weights
-    double arms = 0.0;     // sum of the matched points' squared distances from the sensor
-
-    template <int Rows>
-    void Add(const Eigen::Matrix<double, Rows, 6>& J, const Eigen::Matrix<double, Rows, 1>& r,
-             double w) {
-        H.noalias() += w * J.transpose() * J;
-        g.noalias() += w * J.transpose() * r;
-        ++matched;
-        squared += r.squaredNorm();
-        weight += w;
-    }
-    void Join(const Equations& o) {
-        H += o.H;
-        g += o.g;
-        matched += o.matched;
-        squared += o.squared;
-        weight += o.weight;
-        arms += o.arms;
-    }
-};
-
-// Geman-McClure's weight for a squared residual, scale `kernel` (metres).
-double Weight(double r2, double kernel) {
-    const double k2 = kernel * kernel;
-    return k2 / ((kernel + r2) * (kernel + r2));
-}
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-    Eigen::Matrix3d m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
-}
-
-// The Gauss-Newton update of `e`, left out along the directions the matches do not constrain:
-// there the prediction stands (a street whose only surfaces run along it says nothing about
-// motion along it). The rotation columns are scaled by the matched points' RMS distance from the
-// sensor, so that both kinds of motion are metres; a direction is unconstrained when its
-// eigenvalue per unit of match weight is below `min_eigenvalue`. Returns the smallest such
-// eigenvalue, and in `weak` the eigenvectors of the unconstrained directions (translation in
-// metres, rotation scaled to metres at the arm).
-double SolveConstrained(const Equations& e, double arm_m, double min_eigenvalue, Vector6d* dx,
-                        std::vector<Vector6d>* weak) {
-    Vector6d scale;
-    scale << 1, 1, 1, 1.0 / arm_m, 1.0 / arm_m, 1.0 / arm_m;
-    const Matrix6d H = scale.asDiagonal() * e.H * scale.asDiagonal() / e.weight;
-    const Vector6d g = scale.asDiagonal() * e.g / e.weight;
-    const core::SymmetricEigen<6> eigen = core::DecomposeSymmetric<6>(H);
-    Vector6d step = Vector6d::Zero();
-    weak->clear();
-    for (int i = 0; i < 6; ++i) {
-        const double lambda = eigen.values(i);
-        const Vector6d v = eigen.vectors.col(i);
-        if (lambda < min_eigenvalue) {
-            weak->push_back(v);
-            continue;
-        }
-        step -= (v.dot(g) / lambda) * v;
-    }
-    *dx = scale.asDiagonal() * step;
-    return eigen.values(0);
-}
-
-// In words, a motion the matches left to the prediction: `weakest` (world frame) seen from the
-// sensor at T.
-std::string Unconstrained(const Vector6d& weakest, const Eigen::Isometry3d& T) {
-    const bool moves = weakest.head<3>().squaredNorm() >= weakest.tail<3>().squaredNorm();
-    Eigen::Vector3d axis =
-        (T.linear().transpose() * (moves ? weakest.head<3>() : weakest.tail<3>())).normalized();
-    Eigen::Index largest = 0;
-    (void)axis.cwiseAbs().maxCoeff(&largest);
-    if (axis(largest) < 0.0) axis = -axis;  // an eigenvector's sign is free
-    axis = axis.unaryExpr([](double v) { return std::abs(v) < 0.005 ? 0.0 : v; });  // no -0.00
-    char text[80];
-    std::snprintf(text, sizeof(text), "the %s (%.2f, %.2f, %.2f)",
-                  moves ? "motion along" : "rotation about", axis.x(), axis.y(), axis.z());
-    return text;
-}
-
-std::string Degenerate(const std::vector<Vector6d>& weak, const Eigen::Isometry3d& T) {
-    std::string text = "degenerate: the matches do not fix ";
-    for (size_t i = 0; i < weak.size(); ++i) {
-        text += (i == 0 ? "" : " or ") + Unconstrained(weak[i], T);
-    }
-    return text +
-           " of the sensor (a corridor, a tunnel, an open field); the prediction stood there";
-}
-
-// The points of a sweep, each measured `times[j]` seconds after the stamp, moved into the
-// sensor's frame at the stamp, the sensor moving by `delta` every `interval` seconds (its motion
-// from the scan before). The motion is evaluated at knots a millisecond apart and each point moved
-// by the two around its instant, blended.
-std::vector<Eigen::Vector3d> Deskewed(const std::vector<Eigen::Vector3d>& points,
-                                      const std::vector<float>& times,
-                                      const Eigen::Isometry3d& delta, double interval) {
-    constexpr double kKnotS = 1e-3;
-    const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
-    const double t0 = *lo, span = static_cast<double>(*hi) - t0;
-    const size_t knots = static_cast<size_t>(span / kKnotS) + 2;
-    std::vector<Eigen::Isometry3d> at(knots);
-    for (size_t k = 0; k < knots; ++k) {
-        const double t = t0 + span * static_cast<double>(k) / static_cast<double>(knots - 1);
-        at[k] = core::Interpolate(Eigen::Isometry3d::Identity(), delta, t / interval);
-    }
-    const double scale = span > 0.0 ? static_cast<double>(knots - 1) / span : 0.0;
-    std::vector<Eigen::Vector3d> out(points.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t j = r.begin(); j != r.end(); ++j) {
-                              const double u = (static_cast<double>(times[j]) - t0) * scale;
-                              const size_t k = std::min(static_cast<size_t>(u), knots - 2);
-                              const double f = u - static_cast<double>(k);
-                              out[j] =
-                                  (1.0 - f) * (at[k] * points[j]) + f * (at[k + 1] * points[j]);
-                          }
-                      });
-    return out;
-}
-
-// The rigid motion of a small update (translation, rotation vector), applied on the left.
-Eigen::Isometry3d Exp(const Vector6d& dx) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    const Eigen::Vector3d w = dx.tail<3>();
-    const double angle = w.norm();
-    if (angle > 0.0) T.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-    T.translation() = dx.head<3>();
-    return T;
-}
-
-// The residuals of `source` moved by T against the map, linearised for an update about the
-// sensor's position (a rotation about the sensor, then a translation: the two barely couple).
-Equations Linearise(const detail::LocalMap& map, const std::vector<Eigen::Vector3d>& source,
-                    const Eigen::Isometry3d& T, double threshold, double kernel) {
-    const Eigen::Vector3d centre = T.translation();
-    using Range = tbb::blocked_range<size_t>;
-    return tbb::parallel_deterministic_reduce(
-        Range(0, source.size(), kPointGrain), Equations{},
-        [&](const Range& range, Equations e) {
-            detail::MapMatch m;
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                const Eigen::Vector3d p = T * source[i];
-                if (!map.Nearest(p, threshold, &m)) continue;
-                const Eigen::Vector3d arm = p - centre;
-                if (m.shape == detail::Shape::kPlane) {  // the distance to the plane
-                    Eigen::Matrix<double, 1, 6> J;
-                    J << m.axis.transpose(), arm.cross(m.axis).transpose();
-                    Eigen::Matrix<double, 1, 1> r;
-                    r(0) = m.axis.dot(p - m.point);
-                    e.Add(J, r, Weight(r(0) * r(0), kernel));
-                    e.arms += arm.squaredNorm();
-                } else if (m.shape == detail::Shape::kLine && std::abs(m.axis.z()) >= kMinLineZ) {
-                    // The distance across a pole, a trunk, an upright edge (its direction
-                    // projected out).
-                    const Eigen::Matrix3d across =
-                        Eigen::Matrix3d::Identity() - m.axis * m.axis.transpose();
-                    Eigen::Matrix<double, 3, 6> J;
-                    J << across, -across * Skew(arm);
-                    const Eigen::Vector3d r = across * (p - m.point);
-                    e.Add(J, r, Weight(r.squaredNorm(), kernel));
-                    e.arms += arm.squaredNorm();
-                }
-            }
-            return e;
-        },
-        [](Equations a, const Equations& b) {
-            a.Join(b);
-            return a;
-        });
-}
 
 }  // namespace
 
@@ -373,28 +183,28 @@ Eigen::Isometry3d Odometry::State::Align(const std::vector<Eigen::Vector3d>& fra
     // facade that ended), so nothing is learnt from a farther match.
     const double sigma = Sigma();
     step->threshold_m = std::min(3.0 * sigma, config.voxel_m);
-    Equations e;
-    std::vector<Vector6d> weak;
+    detail::Equations e;
+    std::vector<detail::Vector6d> weak;
     int iterations = 1;
     for (; iterations <= config.max_iterations; ++iterations) {
-        e = Linearise(map, source, T, step->threshold_m, sigma / 3.0);
+        e = detail::Linearise(map, source, T, step->threshold_m, sigma / 3.0);
         if (e.matched < 6) break;
-        Vector6d dx;
-        step->min_eigenvalue = SolveConstrained(
+        detail::Vector6d dx;
+        step->min_eigenvalue = detail::SolveConstrained(
             e, std::sqrt(e.arms / static_cast<double>(e.matched)), kMinEigenvalue, &dx, &weak);
         if (!dx.allFinite()) break;
         const Eigen::Translation3d to_sensor(T.translation());
-        T = to_sensor * Exp(dx) * to_sensor.inverse() * T;
+        T = to_sensor * detail::Exp(dx) * to_sensor.inverse() * T;
         // Products of rotations drift from orthonormal in the last bits; a scan's poses are
         // products of thousands of them by the end of a drive.
         T.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
         if (dx.norm() < config.convergence) break;
     }
     step->iterations += std::min(iterations, config.max_iterations);
-    e = Linearise(map, source, T, step->threshold_m, sigma / 3.0);  // where it ended
+    e = detail::Linearise(map, source, T, step->threshold_m, sigma / 3.0);  // where it ended
     step->correspondences = e.matched;
     step->rmse_m = e.matched > 0 ? std::sqrt(e.squared / static_cast<double>(e.matched)) : 0.0;
-    step->degenerate = weak.empty() ? std::string() : Degenerate(weak, T);
+    step->degenerate = weak.empty() ? std::string() : detail::Degenerate(weak, T);
     return T;
 }
 
@@ -427,10 +237,10 @@ OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& point
         if (const std::optional<Eigen::Matrix3d> R = gyro->Rotation(t, t + since)) {
             sweep.linear() = *R;
         }
-        frame = Thinned(Deskewed(points, *times, sweep, since));
+        frame = Thinned(detail::Deskewed(points, *times, sweep, since));
     } else {
-        frame =
-            Thinned(timed && interval > 0.0 ? Deskewed(points, *times, delta, interval) : points);
+        frame = Thinned(timed && interval > 0.0 ? detail::Deskewed(points, *times, delta, interval)
+                                                : points);
     }
     if (map.empty()) {  // the first scan: the map starts in its frame
         step.points = frame.size();
@@ -461,10 +271,10 @@ OdometryStep Odometry::State::Register(const std::vector<Eigen::Vector3d>& point
             // The map's first sweep, measured while moving too, deskewed at this velocity.
             before = std::move(map);
             map = detail::LocalMap(c.voxel_m, c.max_points_per_voxel, c.max_planarity_ratio);
-            AddFrame(Thinned(Deskewed(first_sweep.points, first_sweep.times, found, since)),
+            AddFrame(Thinned(detail::Deskewed(first_sweep.points, first_sweep.times, found, since)),
                      poses.back());
         }
-        frame = Thinned(Deskewed(points, *times, found, since));
+        frame = Thinned(detail::Deskewed(points, *times, found, since));
         T = Align(frame, T, &step);
     }
     if (!T.matrix().allFinite())
