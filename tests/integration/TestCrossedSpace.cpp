@@ -28,6 +28,15 @@ openvdb::Index64 VoxelsNotIn(const openvdb::MaskTree& a, const openvdb::MaskTree
     return rest.activeVoxelCount();
 }
 
+// A session writer's margin (1 m, or 4 % of a long ray), walking eight rays at a time or one.
+IntegrationConfig SessionMargin(bool wide_walk) {
+    IntegrationConfig config;
+    config.crossed_margin_m = 1.0;
+    config.crossed_margin_fraction = 0.04;
+    config.wide_walk = wide_walk;
+    return config;
+}
+
 TEST(CrossedSpace, LeavesOutTheLastMarginOfEveryRay) {
     core::VoxelMap map = core::VoxelMap::Create(kVoxel);
     IntegrationConfig config;
@@ -82,11 +91,7 @@ double ExitDistance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
 // the scalar walk agree voxel for voxel.
 TEST(CrossedSpace, MarginIsMeasuredAlongEachObliqueRay) {
     core::VoxelMap map = core::VoxelMap::Create(kVoxel);
-    IntegrationConfig wide;
-    wide.crossed_margin_m = 1.0;
-    wide.crossed_margin_fraction = 0.04;
-    IntegrationConfig scalar = wide;
-    scalar.wide_walk = false;
+    const IntegrationConfig wide = SessionMargin(true), scalar = SessionMargin(false);
     const Eigen::Vector3d origin(0.013, -0.021, 0.007);
     size_t checked = 0;
     for (int k = 0; k < 24; ++k) {
@@ -123,11 +128,7 @@ TEST(CrossedSpace, MarginIsMeasuredAlongEachObliqueRay) {
 // free space alike.
 TEST(CrossedSpace, TheWideWalksLanesAgreeWithTheScalarWalk) {
     core::VoxelMap map = core::VoxelMap::Create(kVoxel);
-    IntegrationConfig wide;
-    wide.crossed_margin_m = 1.0;
-    wide.crossed_margin_fraction = 0.04;
-    IntegrationConfig scalar = wide;
-    scalar.wide_walk = false;
+    const IntegrationConfig wide = SessionMargin(true), scalar = SessionMargin(false);
     constexpr openvdb::Index64 kCrossedVoxelsAtLeast = 500000;  // half of the 997,094 measured
     core::Scan scan;
     scan.T_world_sensor.translation() = Eigen::Vector3d(0.013, -0.021, 0.007);
